@@ -1,0 +1,13 @@
+//! # stamp — the framework crate
+//!
+//! A generic finite-element framework for structures in frictionless contact with rigid punches.
+//! Data flows one way: mesh -> degrees of freedom -> assembly -> nonlinear solver -> output. This crate
+//! knows nothing about plates or cylinders: elements plug in through [`element::Element`], punch
+//! shapes through [`surface::ContactSurface`], solution strategies through
+//! [`nonlinear::NonlinearSolver`].
+
+pub mod error;
+pub mod mesh;
+pub mod surface;
+
+pub use error::{Result, StampError};
