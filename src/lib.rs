@@ -11,3 +11,11 @@ pub mod mesh;
 pub mod surface;
 
 pub use error::{Result, StampError};
+pub mod dofs;
+pub mod element;
+pub mod linear_solver;
+pub mod sparse;
+pub mod assembly;
+pub mod contact;
+pub mod model;
+pub mod nonlinear;

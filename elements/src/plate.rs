@@ -1,0 +1,334 @@
+//! The mixed (Hu-Washizu) four-node plate element of the paper (section 4), as a stamp
+//! [`Element`]. Unknowns per node: the six face displacements [v1-, v2-, v3-, v1+, v2+, v3+].
+//!
+//! With the strains E and the resultants T eliminated on the element (eqs. 4.7, 4.11), the internal
+//! force is G(V) = int (dE/dV)^T D E dA (eq. 4.12), E the assumed strains of [`crate::geometry`], and
+//! the tangent K = int (dE/dV)^T D (dE/dV) + sum_c T_c d2E_c/dV2 dA (eq. 4.13), exact: Newton
+//! converges quadratically. D is not symmetric (b_ab33 = 0), nor is K.
+
+use crate::geometry::{ElementGeometry, GAUSS_POINTS};
+use crate::material::{Section, NSTRAIN};
+use crate::strain::{Affine, Sample, NDOF, NPAIR};
+use stamp::element::{Element, LocalSystem};
+use stamp::mesh::QuadMesh;
+use stamp::Result;
+
+/// Dofs per node: v-_1, v-_2, v-_3, v+_1, v+_2, v+_3.
+pub const DOFS_PER_NODE: usize = 6;
+
+/// The two face planes of the plate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Face {
+    /// S-, at x3 = delta-.
+    Bottom,
+    /// S+, at x3 = delta+.
+    Top,
+}
+
+impl Face {
+    /// 0 for S-, 1 for S+.
+    pub fn index(self) -> usize {
+        match self {
+            Face::Bottom => 0,
+            Face::Top => 1,
+        }
+    }
+    /// Global dof of displacement component `comp` (0, 1, 2) of this face at `node`.
+    pub fn dof(self, node: usize, comp: usize) -> usize {
+        node * DOFS_PER_NODE + 3 * self.index() + comp
+    }
+}
+
+/// Geometrically nonlinear (Green-Lagrange, exact rigid-body motions) or linear (eta = 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Kinematics {
+    Nonlinear,
+    Linear,
+}
+
+// Sample numbering (see strain.rs): displacement-based strains evaluated per element.
+const MEM: usize = 0; // + g*6 + face*3 + {0: E11, 1: E22, 2: 2E12}
+const E33: usize = 24; // + g
+const LINE: usize = 28; // + pt*2 + face: full covariant shear on the lines
+const LINE_LIN: usize = 36; // + pt*2 + face: its linear part
+const TYING_LIN: usize = 44; // + pt*2 + face: linear covariant shear at the edge midpoints
+const NSAMPLE: usize = 52;
+const NQUAD: usize = 36; // samples with a Hessian (nonlinear kinematics)
+
+/// Per-thread scratch memory of the plate element.
+pub struct PlateWorkspace {
+    samples: Box<[Sample; NSAMPLE]>,
+    b: [[f64; NDOF]; NSTRAIN],
+    db: [[f64; NDOF]; NSTRAIN],
+    mu: [f64; NSAMPLE],
+}
+
+/// The assumed strains and resultants at the element's Gauss points.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct GaussState {
+    pub strain: [[f64; NSTRAIN]; 4],
+    pub resultant: [[f64; NSTRAIN]; 4],
+}
+
+/// The plate elements of a mesh.
+pub struct PlateElements {
+    cells: Vec<[usize; 4]>,
+    geometry: Vec<ElementGeometry>,
+    d: [[f64; NSTRAIN]; NSTRAIN],
+    section: Section,
+    kinematics: Kinematics,
+}
+
+/// Up to 8 (sample, coefficient) terms of an assumed strain.
+type Terms = ([(usize, f64); 8], usize);
+
+impl PlateElements {
+    /// Plate elements on every cell of `mesh`, with a validated section.
+    pub fn new(mesh: &QuadMesh, section: Section, kinematics: Kinematics) -> Result<Self> {
+        section.validate()?;
+        mesh.validate()?;
+        let geometry = (0..mesh.num_cells()).map(|c| ElementGeometry::new(&mesh.cell_coords(c), c)).collect::<Result<Vec<_>>>()?;
+        Ok(PlateElements { cells: mesh.cells.clone(), geometry, d: section.stiffness(), section, kinematics })
+    }
+
+    pub fn section(&self) -> &Section {
+        &self.section
+    }
+    pub fn kinematics(&self) -> Kinematics {
+        self.kinematics
+    }
+    /// The plate stiffness D (eq. 2.6, with b_ab33 = 0).
+    pub fn stiffness(&self) -> &[[f64; NSTRAIN]; NSTRAIN] {
+        &self.d
+    }
+    /// Geometry of element e.
+    pub fn geometry(&self, e: usize) -> &ElementGeometry {
+        &self.geometry[e]
+    }
+
+    /// The (sample, coefficient) terms of assumed strain component `c` at Gauss point `g`.
+    fn terms(geo: &ElementGeometry, g: usize, c: usize) -> Terms {
+        let mut t = [(0usize, 0.0); 8];
+        let mut n = 0;
+        let mut push = |s: usize, w: f64| {
+            if w != 0.0 {
+                t[n] = (s, w);
+                n += 1;
+            }
+        };
+        let face = c % 2;
+        match c {
+            0 | 1 | 2 | 3 | 4 | 5 => {
+                let kind = c / 2; // 0: E11 rows, 1: E22 columns, 2: E12 all
+                for h in 0..4 {
+                    push(MEM + h * 6 + face * 3 + kind, geo.proj[kind][g][h]);
+                }
+            }
+            6 | 7 | 8 | 9 => {
+                let row = if c < 8 { 0 } else { 1 }; // 2E13 or 2E23 (local Cartesian)
+                let [x1, x2] = GAUSS_POINTS[g];
+                // covariant gamma_xi1 on the line xi1 = 0 at xi2 = x2, gamma_xi2 on xi2 = 0 at xi1 = x1
+                let comps = [(if x2 < 0.0 { 0 } else { 1 }, x2, 0usize), (if x1 < 0.0 { 2 } else { 3 }, x1, 2usize)];
+                for (a, &(pt, xi, tp)) in comps.iter().enumerate() {
+                    let w = geo.jit[g][row][a];
+                    push(LINE + pt * 2 + face, w);
+                    push(LINE_LIN + pt * 2 + face, -w);
+                    push(TYING_LIN + tp * 2 + face, w * 0.5 * (1.0 - xi));
+                    push(TYING_LIN + (tp + 1) * 2 + face, w * 0.5 * (1.0 + xi));
+                }
+            }
+            _ => push(E33 + g, 1.0),
+        }
+        (t, n)
+    }
+
+    /// Evaluate every displacement-based strain sample of element e at local dofs `v`.
+    fn compute_samples(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace) {
+        let geo = &self.geometry[e];
+        let h = self.section.thickness();
+        let nonlinear = self.kinematics == Kinematics::Nonlinear;
+        let fibre = |n: &[f64; 4]| {
+            let mut c = [0.0; NPAIR];
+            for a in 0..4 {
+                c[2 * a] = -n[a] / h;
+                c[2 * a + 1] = n[a] / h;
+            }
+            Affine::new([0.0, 0.0, 1.0], c, v)
+        };
+        let tangent = |g0: [f64; 2], dn: [f64; 4], face: usize| {
+            let mut c = [0.0; NPAIR];
+            for a in 0..4 {
+                c[2 * a + face] = dn[a];
+            }
+            Affine::new([g0[0], g0[1], 0.0], c, v)
+        };
+        let s = &mut ws.samples;
+        let mut put = |id: usize, scale: f64, a: &Affine, b: &Affine, full: bool| {
+            if full && nonlinear {
+                s[id].quadratic(scale, a, b)
+            } else {
+                s[id].linear(scale, a, b)
+            }
+        };
+        for g in 0..4 {
+            let g3 = fibre(&geo.n[g]);
+            put(E33 + g, 0.5, &g3, &g3, true);
+            for face in 0..2 {
+                let dn = |i: usize| [geo.dndy[g][0][i], geo.dndy[g][1][i], geo.dndy[g][2][i], geo.dndy[g][3][i]];
+                let g1 = tangent(geo.frame[0], dn(0), face);
+                let g2 = tangent(geo.frame[1], dn(1), face);
+                let base = MEM + g * 6 + face * 3;
+                put(base, 0.5, &g1, &g1, true);
+                put(base + 1, 0.5, &g2, &g2, true);
+                put(base + 2, 1.0, &g1, &g2, true);
+            }
+        }
+        for pt in 0..4 {
+            let lp = &geo.line[pt];
+            let tp = &geo.tying[pt];
+            let g3l = fibre(&lp.n);
+            let g3t = fibre(&tp.n);
+            for face in 0..2 {
+                let gl = tangent(lp.base, lp.dn, face);
+                put(LINE + pt * 2 + face, 1.0, &gl, &g3l, true);
+                put(LINE_LIN + pt * 2 + face, 1.0, &gl, &g3l, false);
+                let gt = tangent(tp.base, tp.dn, face);
+                put(TYING_LIN + pt * 2 + face, 1.0, &gt, &g3t, false);
+            }
+        }
+    }
+
+    /// Assumed strains and stress resultants at the Gauss points of element `e` for local dofs `v`
+    /// (for output: membrane forces, moments, shear forces follow from the face resultants).
+    pub fn gauss_state(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace) -> GaussState {
+        self.compute_samples(e, v, ws);
+        let geo = &self.geometry[e];
+        let mut out = GaussState::default();
+        for g in 0..4 {
+            for c in 0..NSTRAIN {
+                let (t, n) = Self::terms(geo, g, c);
+                out.strain[g][c] = t[..n].iter().map(|&(s, w)| w * ws.samples[s].val).sum();
+            }
+            for r in 0..NSTRAIN {
+                out.resultant[g][r] = (0..NSTRAIN).map(|c| self.d[r][c] * out.strain[g][c]).sum();
+            }
+        }
+        out
+    }
+}
+
+impl Element for PlateElements {
+    type Workspace = PlateWorkspace;
+
+    fn dofs_per_node(&self) -> usize {
+        DOFS_PER_NODE
+    }
+    fn nodes_per_element(&self) -> usize {
+        4
+    }
+    fn num_elements(&self) -> usize {
+        self.cells.len()
+    }
+    fn element_nodes(&self, e: usize) -> &[usize] {
+        &self.cells[e]
+    }
+    fn new_workspace(&self) -> PlateWorkspace {
+        PlateWorkspace {
+            samples: Box::new([Sample::default(); NSAMPLE]),
+            b: [[0.0; NDOF]; NSTRAIN],
+            db: [[0.0; NDOF]; NSTRAIN],
+            mu: [0.0; NSAMPLE],
+        }
+    }
+
+    fn evaluate(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        self.compute_samples(e, v, ws);
+        let geo = &self.geometry[e];
+        let d = &self.d;
+        ws.mu = [0.0; NSAMPLE];
+        for g in 0..4 {
+            let w = geo.wdet[g];
+            let mut strain = [0.0; NSTRAIN];
+            let mut terms = [([(0usize, 0.0); 8], 0usize); NSTRAIN];
+            for c in 0..NSTRAIN {
+                terms[c] = Self::terms(geo, g, c);
+                let (t, n) = &terms[c];
+                let row = &mut ws.b[c];
+                *row = [0.0; NDOF];
+                for &(s, coef) in &t[..*n] {
+                    let smp = &ws.samples[s];
+                    strain[c] += coef * smp.val;
+                    for i in 0..NDOF {
+                        row[i] += coef * smp.grad[i];
+                    }
+                }
+            }
+            let mut stress = [0.0; NSTRAIN];
+            for r in 0..NSTRAIN {
+                stress[r] = (0..NSTRAIN).map(|c| d[r][c] * strain[c]).sum();
+            }
+            out.energy += 0.5 * w * (0..NSTRAIN).map(|c| strain[c] * stress[c]).sum::<f64>();
+            for c in 0..NSTRAIN {
+                let f = w * stress[c];
+                for i in 0..NDOF {
+                    out.residual[i] += f * ws.b[c][i];
+                }
+            }
+            if !with_tangent {
+                continue;
+            }
+            // D B
+            for r in 0..NSTRAIN {
+                let mut row = [0.0; NDOF];
+                for c in 0..NSTRAIN {
+                    let drc = d[r][c];
+                    if drc != 0.0 {
+                        for i in 0..NDOF {
+                            row[i] += drc * ws.b[c][i];
+                        }
+                    }
+                }
+                ws.db[r] = row;
+            }
+            // B^T D B
+            for c in 0..NSTRAIN {
+                for i in 0..NDOF {
+                    let bi = w * ws.b[c][i];
+                    if bi == 0.0 {
+                        continue;
+                    }
+                    let krow = &mut out.tangent[i * NDOF..(i + 1) * NDOF];
+                    for j in 0..NDOF {
+                        krow[j] += bi * ws.db[c][j];
+                    }
+                }
+            }
+            // weights of the sample Hessians in the geometric stiffness
+            for c in 0..NSTRAIN {
+                let (t, n) = &terms[c];
+                for &(s, coef) in &t[..*n] {
+                    ws.mu[s] += w * stress[c] * coef;
+                }
+            }
+        }
+        if with_tangent && self.kinematics == Kinematics::Nonlinear {
+            for s in 0..NQUAD {
+                let m = ws.mu[s];
+                if m == 0.0 {
+                    continue;
+                }
+                let hs = &ws.samples[s].hess;
+                for k in 0..NPAIR {
+                    for l in 0..NPAIR {
+                        let val = m * hs[k][l];
+                        if val != 0.0 {
+                            for i in 0..3 {
+                                out.tangent[(3 * k + i) * NDOF + 3 * l + i] += val;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,86 @@
+//! Displacement-based Green-Lagrange strains as exact quadratic forms of the element's nodal
+//! displacements (paper eqs. 1.4-1.5, 1.9).
+//!
+//! Every strain of the plate is a dot product of two vectors that are affine in the nodal face
+//! displacements: the face tangents g_a = t_a + v_,a, the transverse fibre g_3 = e3 + beta with
+//! beta = (v+ - v-)/h, and the covariant tangents g_xi = X_,xi + v_,xi. So 2 E_ij = g_i . g_j -
+//! G_i . G_j (eq. 1.5 in vector form), which vanishes for any rigid motion because a rotation keeps
+//! dot products (eqs. 1.6-1.8). A [`Sample`] stores the value, gradient and (constant) Hessian of
+//! one such strain; the Hessian is a scalar 8 x 8 matrix over (node, face) pairs times the 3 x 3
+//! identity.
+
+/// Element dofs: 4 nodes x 2 faces x 3 components; local dof 3k + i is component i of the
+/// displacement of (node, face) pair k = 2 node + face (face 0 = S-, 1 = S+).
+pub const NDOF: usize = 24;
+/// (node, face) pairs.
+pub const NPAIR: usize = 8;
+
+/// A vector affine in the nodal face displacements: g = g0 + sum_k c_k v_k.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Affine {
+    pub g0: [f64; 3],
+    pub g: [f64; 3],
+    pub c: [f64; NPAIR],
+}
+
+impl Affine {
+    /// Build from the reference vector and the coefficients, evaluating g at `v`.
+    pub fn new(g0: [f64; 3], c: [f64; NPAIR], v: &[f64]) -> Self {
+        let mut g = g0;
+        for k in 0..NPAIR {
+            if c[k] != 0.0 {
+                for i in 0..3 {
+                    g[i] += c[k] * v[3 * k + i];
+                }
+            }
+        }
+        Affine { g0, g, c }
+    }
+}
+
+/// One strain: value, gradient with respect to the 24 element dofs, and Hessian coefficients.
+#[derive(Debug, Clone, Copy)]
+pub struct Sample {
+    pub val: f64,
+    pub grad: [f64; NDOF],
+    pub hess: [[f64; NPAIR]; NPAIR],
+}
+
+impl Default for Sample {
+    fn default() -> Self {
+        Sample { val: 0.0, grad: [0.0; NDOF], hess: [[0.0; NPAIR]; NPAIR] }
+    }
+}
+
+#[inline]
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl Sample {
+    /// The full (Green-Lagrange) strain s (gA . gB - g0A . g0B).
+    pub fn quadratic(&mut self, s: f64, a: &Affine, b: &Affine) {
+        self.val = s * (dot(&a.g, &b.g) - dot(&a.g0, &b.g0));
+        for k in 0..NPAIR {
+            for i in 0..3 {
+                self.grad[3 * k + i] = s * (a.c[k] * b.g[i] + b.c[k] * a.g[i]);
+            }
+            for l in 0..NPAIR {
+                self.hess[k][l] = s * (a.c[k] * b.c[l] + b.c[k] * a.c[l]);
+            }
+        }
+    }
+
+    /// The part linear in the displacements, s (g0A . dB + g0B . dA) with d = g - g0: the strain of
+    /// the geometrically linear theory (eta = 0). The Hessian is zero and is not written.
+    pub fn linear(&mut self, s: f64, a: &Affine, b: &Affine) {
+        let da = [a.g[0] - a.g0[0], a.g[1] - a.g0[1], a.g[2] - a.g0[2]];
+        let db = [b.g[0] - b.g0[0], b.g[1] - b.g0[1], b.g[2] - b.g0[2]];
+        self.val = s * (dot(&a.g0, &db) + dot(&b.g0, &da));
+        for k in 0..NPAIR {
+            for i in 0..3 {
+                self.grad[3 * k + i] = s * (a.c[k] * b.g0[i] + b.c[k] * a.g0[i]);
+            }
+        }
+    }
+}

@@ -1,0 +1,134 @@
+//! The generic assembler: evaluates any [`Element`] set in parallel (rayon) and adds the local
+//! residuals and tangents into a full-length force vector and the value array of a
+//! [`SparsePattern`]. Elements are split into colours such that no two elements of one colour share a
+//! node; the elements of a colour then write disjoint entries and run in parallel without locks.
+//! Each thread keeps one workspace and one local system: nothing is allocated per element.
+
+use crate::dofs::DofMap;
+use crate::element::{Element, LocalSystem};
+use crate::sparse::SparsePattern;
+use rayon::prelude::*;
+
+/// Greedy colouring of the elements so that elements of one colour share no node.
+pub fn color_elements(num_nodes: usize, num_elements: usize, element_nodes: impl Fn(usize) -> Vec<usize>) -> Vec<Vec<usize>> {
+    // node -> bitmask of colours already used by its elements (up to 64 colours, then fall back)
+    let mut used: Vec<u64> = vec![0; num_nodes];
+    let mut colors: Vec<Vec<usize>> = Vec::new();
+    for e in 0..num_elements {
+        let nodes = element_nodes(e);
+        let mask = nodes.iter().fold(0u64, |m, &n| m | used[n]);
+        let c = (!mask).trailing_zeros() as usize;
+        let c = c.min(63);
+        if c >= colors.len() {
+            colors.resize(c + 1, Vec::new());
+        }
+        colors[c].push(e);
+        for &n in &nodes {
+            used[n] |= 1u64 << c;
+        }
+    }
+    // colour 63 may hold conflicting elements if more than 63 colours were needed: split it serially
+    if colors.len() == 64 {
+        let overflow = std::mem::take(&mut colors[63]);
+        colors.pop();
+        for e in overflow {
+            colors.push(vec![e]);
+        }
+    }
+    colors
+}
+
+/// Pointer wrapper used to write disjoint entries from several threads.
+#[derive(Clone, Copy)]
+struct SharedMut(*mut f64);
+unsafe impl Send for SharedMut {}
+unsafe impl Sync for SharedMut {}
+
+/// Assembles one element set into a pattern. Built once per model; reused for every assembly.
+pub struct Assembler {
+    colors: Vec<Vec<usize>>,
+}
+
+impl Assembler {
+    /// Colour the elements of `element`.
+    pub fn new<E: Element>(element: &E, num_nodes: usize) -> Self {
+        let colors = color_elements(num_nodes, element.num_elements(), |e| element.element_nodes(e).to_vec());
+        Assembler { colors }
+    }
+
+    /// Number of colours (for diagnostics).
+    pub fn num_colors(&self) -> usize {
+        self.colors.len()
+    }
+
+    /// Evaluate all elements at the full dof vector `u`, add their internal forces into `force`
+    /// (length = number of dofs, prescribed dofs included: those entries are reactions) and, if
+    /// `values` is given, their tangents into it (in `pattern`). Returns the total strain energy.
+    /// `force` and `values` are overwritten, not accumulated.
+    pub fn assemble<E: Element>(&self, element: &E, dofs: &DofMap, pattern: &SparsePattern, u: &[f64], force: &mut [f64], values: Option<&mut [f64]>) -> f64 {
+        let dpn = dofs.dofs_per_node();
+        let npe = element.nodes_per_element();
+        let nloc = dpn * npe;
+        force.par_iter_mut().for_each(|f| *f = 0.0);
+        let with_tangent = values.is_some();
+        let vals_ptr = match values {
+            Some(v) => {
+                v.par_iter_mut().for_each(|x| *x = 0.0);
+                SharedMut(v.as_mut_ptr())
+            }
+            None => SharedMut(std::ptr::null_mut()),
+        };
+        let force_ptr = SharedMut(force.as_mut_ptr());
+        let eqs = dofs.equations();
+        let mut energy = 0.0;
+        for color in &self.colors {
+            energy += color
+                .par_iter()
+                .fold(
+                    || (element.new_workspace(), LocalSystem::new(nloc), vec![0.0; nloc], vec![0usize; nloc], 0.0f64),
+                    |(mut ws, mut local, mut ue, mut gdof, mut en), &e| {
+                        let nodes = element.element_nodes(e);
+                        for (a, &n) in nodes.iter().enumerate() {
+                            for c in 0..dpn {
+                                gdof[a * dpn + c] = n * dpn + c;
+                                ue[a * dpn + c] = u[n * dpn + c];
+                            }
+                        }
+                        local.clear();
+                        element.evaluate(e, &ue, &mut ws, &mut local, with_tangent);
+                        en += local.energy;
+                        // SAFETY: elements of one colour share no node, so they write disjoint
+                        // entries of `force` and of the value array.
+                        unsafe {
+                            let fp = force_ptr;
+                            for i in 0..nloc {
+                                *fp.0.add(gdof[i]) += local.residual[i];
+                            }
+                            if with_tangent {
+                                let vp = vals_ptr;
+                                for j in 0..nloc {
+                                    let ce = eqs[gdof[j]];
+                                    if ce == crate::dofs::PRESCRIBED {
+                                        continue;
+                                    }
+                                    let b = j / dpn;
+                                    for i in 0..nloc {
+                                        if eqs[gdof[i]] == crate::dofs::PRESCRIBED {
+                                            continue;
+                                        }
+                                        let a = i / dpn;
+                                        let s = pattern.slot(e, a, b, gdof[i], ce as usize);
+                                        *vp.0.add(s) += local.tangent[i * nloc + j];
+                                    }
+                                }
+                            }
+                        }
+                        (ws, local, ue, gdof, en)
+                    },
+                )
+                .map(|t| t.4)
+                .sum::<f64>();
+        }
+        energy
+    }
+}

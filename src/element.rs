@@ -1,0 +1,53 @@
+//! The element interface: what the assembler needs from a finite-element formulation. In the spirit
+//! of MFEM's integrators, one object gives the residual (internal force), the tangent and the energy
+//! of an element; like fenris, it works in a caller-owned workspace so that the hot loop allocates
+//! nothing.
+
+/// The local result of one element: internal force vector, tangent matrix (row-major, square) and
+/// strain energy. Allocated once per thread and reused for every element.
+#[derive(Debug, Clone)]
+pub struct LocalSystem {
+    pub residual: Vec<f64>,
+    pub tangent: Vec<f64>,
+    pub energy: f64,
+}
+
+impl LocalSystem {
+    pub fn new(num_dofs: usize) -> Self {
+        LocalSystem { residual: vec![0.0; num_dofs], tangent: vec![0.0; num_dofs * num_dofs], energy: 0.0 }
+    }
+    pub fn num_dofs(&self) -> usize {
+        self.residual.len()
+    }
+    /// Zero everything.
+    pub fn clear(&mut self) {
+        self.residual.fill(0.0);
+        self.tangent.fill(0.0);
+        self.energy = 0.0;
+    }
+}
+
+/// A set of finite elements of one kind over a mesh (the plate elements of a plate, say).
+///
+/// Element dofs are node-major: local dof `a * dofs_per_node() + c` is component `c` at the element's
+/// node `a`. `evaluate` must be a pure function of the element's dof values (any history lives in the
+/// implementor and is updated outside the assembly), so that elements can be evaluated in parallel.
+pub trait Element: Sync {
+    /// Per-thread scratch memory.
+    type Workspace: Send;
+
+    /// Number of unknowns at each node.
+    fn dofs_per_node(&self) -> usize;
+    /// Nodes of each element (all elements of one set have the same number).
+    fn nodes_per_element(&self) -> usize;
+    /// Number of elements.
+    fn num_elements(&self) -> usize;
+    /// Global node indices of element `e`.
+    fn element_nodes(&self, e: usize) -> &[usize];
+    /// A fresh workspace.
+    fn new_workspace(&self) -> Self::Workspace;
+    /// Evaluate element `e` at the local dof values `u`: fill `out.residual` (internal force), the
+    /// strain energy and, when `with_tangent`, `out.tangent` = d residual / d u (not necessarily
+    /// symmetric). `out` is cleared by the caller.
+    fn evaluate(&self, e: usize, u: &[f64], ws: &mut Self::Workspace, out: &mut LocalSystem, with_tangent: bool);
+}

@@ -1,0 +1,119 @@
+//! The linear-solver layer: a trait for "factorise, then solve", and its implementation over
+//! faer's sparse LU. The symbolic factorisation (fill-reducing ordering, elimination structure) is
+//! computed once for the pattern and reused by every numeric factorisation; so is the memory of the
+//! numeric factors.
+
+use crate::error::{Result, StampError};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::SparseColMatRef;
+use faer::{Conj, MatMut, Par};
+use std::time::Instant;
+
+/// Seconds spent in each phase of the linear solves, cumulative.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct SolverTimings {
+    pub symbolic: f64,
+    pub factorization: f64,
+    pub solve: f64,
+    pub factorizations: usize,
+    pub solves: usize,
+}
+
+/// Factorise a sparse square matrix and solve with it.
+pub trait LinearSolver: Send {
+    /// Factorise `a`. Implementations may reuse anything computed for an earlier matrix with the same
+    /// pattern.
+    fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()>;
+    /// Solve A x = b in place with the last factorisation.
+    fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()>;
+    /// Time spent so far.
+    fn timings(&self) -> SolverTimings;
+}
+
+/// Sparse LU with partial pivoting (faer), symbolic phase computed once.
+pub struct SparseLu {
+    symbolic: Option<SymbolicLu<usize>>,
+    numeric: NumericLu<usize, f64>,
+    factored: bool,
+    pattern_nnz: usize,
+    timings: SolverTimings,
+    par: Par,
+    buffer: Option<MemBuffer>,
+}
+
+impl Default for SparseLu {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl SparseLu {
+    /// A solver that uses faer's global parallelism setting.
+    pub fn new() -> Self {
+        SparseLu {
+            symbolic: None,
+            numeric: NumericLu::new(),
+            factored: false,
+            pattern_nnz: 0,
+            timings: SolverTimings::default(),
+            par: faer::get_global_parallelism(),
+            buffer: None,
+        }
+    }
+
+    /// Use a given parallelism for the factorisation and solves.
+    pub fn with_parallelism(par: Par) -> Self {
+        SparseLu { par, ..Self::new() }
+    }
+}
+
+impl LinearSolver for SparseLu {
+    fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
+        let nnz = a.symbolic().row_idx().len();
+        if self.symbolic.is_none() || self.pattern_nnz != nnz {
+            let t = Instant::now();
+            let sym = factorize_symbolic_lu(a.symbolic(), Default::default())
+                .map_err(|e| StampError::LinearSolver(format!("symbolic LU failed: {e:?}")))?;
+            let scratch = sym.factorize_numeric_lu_scratch::<f64>(self.par, Default::default())
+                .or(sym.solve_in_place_scratch::<f64>(1, self.par));
+            self.buffer = Some(MemBuffer::try_new(scratch).map_err(|_| StampError::LinearSolver("out of memory for LU workspace".into()))?);
+            self.symbolic = Some(sym);
+            self.pattern_nnz = nnz;
+            self.timings.symbolic += t.elapsed().as_secs_f64();
+        }
+        let t = Instant::now();
+        let sym = self.symbolic.as_ref().unwrap();
+        let stack = MemStack::new(self.buffer.as_mut().unwrap());
+        self.factored = false;
+        sym.factorize_numeric_lu(&mut self.numeric, a, self.par, stack, Default::default())
+            .map_err(|e| StampError::LinearSolver(format!("numeric LU failed (singular matrix?): {e:?}")))?;
+        self.factored = true;
+        self.timings.factorization += t.elapsed().as_secs_f64();
+        self.timings.factorizations += 1;
+        Ok(())
+    }
+
+    fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()> {
+        if !self.factored {
+            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
+        }
+        let t = Instant::now();
+        let sym = self.symbolic.as_ref().unwrap();
+        let lu = LuRef::new_unchecked(sym, &self.numeric);
+        let n = b.len();
+        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
+        let stack = MemStack::new(self.buffer.as_mut().unwrap());
+        lu.solve_in_place_with_conj(Conj::No, rhs, self.par, stack);
+        self.timings.solve += t.elapsed().as_secs_f64();
+        self.timings.solves += 1;
+        if b.iter().any(|x| !x.is_finite()) {
+            return Err(StampError::LinearSolver("the solution has non-finite entries: the matrix is singular".into()));
+        }
+        Ok(())
+    }
+
+    fn timings(&self) -> SolverTimings {
+        self.timings
+    }
+}

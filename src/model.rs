@@ -1,0 +1,199 @@
+//! A model: one element set on a mesh, its dofs and constraints, nodal loads and punches. It is the
+//! [`NonlinearProblem`] the solver drives: R(u, t) = f_int(u) + f_contact(u, t) - t f_ext.
+
+use crate::assembly::Assembler;
+use crate::contact::{ContactPair, PointState};
+use crate::dofs::DofMap;
+use crate::element::Element;
+use crate::error::{Result, StampError};
+use crate::nonlinear::{Evaluation, NonlinearProblem};
+use crate::sparse::SparsePattern;
+use faer::sparse::SparseColMatRef;
+use std::time::Instant;
+
+/// Seconds spent assembling, cumulative.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct ModelTimings {
+    pub assembly: f64,
+    pub contact: f64,
+    pub assemblies: usize,
+}
+
+/// Elements + dofs + loads + contact: everything that defines R(u, t).
+pub struct Model<E: Element> {
+    pub element: E,
+    pub dofs: DofMap,
+    /// Nodal forces (dof, value at load factor 1).
+    pub loads: Vec<(usize, f64)>,
+    pub contacts: Vec<ContactPair>,
+    /// Augmented-Lagrangian tolerance on the penetration (a length); `None` for the plain perturbed
+    /// Lagrangian.
+    pub augmented_tolerance: Option<f64>,
+    pattern: SparsePattern,
+    assembler: Assembler,
+    /// Internal + contact force over all dofs at the last evaluation (reactions at prescribed dofs).
+    force: Vec<f64>,
+    values: Vec<f64>,
+    residual: Vec<f64>,
+    energy: f64,
+    saved: Vec<(Vec<f64>, Vec<PointState>)>,
+    pub timings: ModelTimings,
+}
+
+impl<E: Element> Model<E> {
+    /// Build the pattern and the element colouring.
+    pub fn new(element: E, dofs: DofMap) -> Result<Self> {
+        if element.dofs_per_node() != dofs.dofs_per_node() {
+            return Err(StampError::Problem(format!(
+                "the element has {} dofs per node, the dof map {}",
+                element.dofs_per_node(),
+                dofs.dofs_per_node()
+            )));
+        }
+        if dofs.num_equations() == 0 {
+            return Err(StampError::Problem("every dof is prescribed: nothing to solve".into()));
+        }
+        let pattern = SparsePattern::new(&dofs, element.num_elements(), element.nodes_per_element(), |e| element.element_nodes(e).to_vec())?;
+        let assembler = Assembler::new(&element, dofs.num_nodes());
+        let nnz = pattern.nnz();
+        Ok(Model {
+            force: vec![0.0; dofs.num_dofs()],
+            values: vec![0.0; nnz],
+            residual: vec![0.0; dofs.num_equations()],
+            element,
+            dofs,
+            loads: Vec::new(),
+            contacts: Vec::new(),
+            augmented_tolerance: None,
+            pattern,
+            assembler,
+            energy: 0.0,
+            saved: Vec::new(),
+            timings: ModelTimings::default(),
+        })
+    }
+
+    /// Add a nodal force (value at load factor 1) on a dof.
+    pub fn add_load(&mut self, dof: usize, value: f64) -> Result<()> {
+        if dof >= self.dofs.num_dofs() || !value.is_finite() {
+            return Err(StampError::Problem(format!("invalid load {value} on dof {dof}")));
+        }
+        self.loads.push((dof, value));
+        Ok(())
+    }
+
+    /// Internal + contact forces over all dofs at the last evaluation; at prescribed dofs these are
+    /// the support reactions (with the sign of a force the body exerts on the support).
+    pub fn nodal_forces(&self) -> &[f64] {
+        &self.force
+    }
+
+    /// Strain energy at the last evaluation.
+    pub fn energy(&self) -> f64 {
+        self.energy
+    }
+
+    /// The sparsity pattern.
+    pub fn pattern(&self) -> &SparsePattern {
+        &self.pattern
+    }
+
+    /// Number of element colours of the parallel assembly.
+    pub fn num_colors(&self) -> usize {
+        self.assembler.num_colors()
+    }
+}
+
+impl<E: Element> NonlinearProblem for Model<E> {
+    fn num_dofs(&self) -> usize {
+        self.dofs.num_dofs()
+    }
+    fn num_equations(&self) -> usize {
+        self.dofs.num_equations()
+    }
+    fn apply_prescribed(&self, u: &mut [f64], t: f64) {
+        self.dofs.apply_prescribed(u, t);
+    }
+
+    fn evaluate(&mut self, u: &[f64], t: f64, with_tangent: bool) -> Result<Evaluation> {
+        let start = Instant::now();
+        let values = if with_tangent { Some(self.values.as_mut_slice()) } else { None };
+        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force, values);
+        let internal_norm = self.force.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let t_contact = Instant::now();
+        self.timings.assembly += (t_contact - start).as_secs_f64();
+        self.timings.assemblies += 1;
+        let mut changes = 0;
+        let mut contact_sq = 0.0;
+        {
+            let pattern = &self.pattern;
+            let dofs = &self.dofs;
+            let values = &mut self.values;
+            let mut add = |r: usize, c: usize, v: f64| {
+                if let Some(s) = pattern.nodal_slot(dofs, r, c) {
+                    values[s] += v;
+                }
+            };
+            for pair in self.contacts.iter_mut() {
+                let before: Vec<f64> = pair.points.iter().flat_map(|p| p.dofs.map(|d| self.force[d])).collect();
+                changes += if with_tangent { pair.evaluate(u, t, &mut self.force, Some(&mut add)) } else { pair.evaluate(u, t, &mut self.force, None) };
+                contact_sq += pair.points.iter().flat_map(|p| p.dofs).zip(&before).map(|(d, b)| (self.force[d] - b).powi(2)).sum::<f64>();
+            }
+        }
+        self.timings.contact += t_contact.elapsed().as_secs_f64();
+        let mut ext_sq = 0.0;
+        let mut ext = vec![0.0; 0];
+        let _ = &mut ext;
+        for r in self.residual.iter_mut() {
+            *r = 0.0;
+        }
+        self.dofs.gather(&self.force, &mut self.residual);
+        for &(d, v) in &self.loads {
+            ext_sq += (t * v) * (t * v);
+            if let Some(e) = self.dofs.equation(d) {
+                self.residual[e] -= t * v;
+            }
+        }
+        let norm = self.residual.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !norm.is_finite() {
+            return Err(StampError::NonFinite(format!("the residual at load factor {t} is not finite (element or contact produced NaN)")));
+        }
+        let scale = internal_norm.max(ext_sq.sqrt()).max(contact_sq.sqrt());
+        Ok(Evaluation { residual_norm: norm, force_scale: scale, active_changes: changes })
+    }
+
+    fn residual(&self) -> &[f64] {
+        &self.residual
+    }
+    fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
+        self.pattern.matrix(&self.values)
+    }
+    fn add_increment(&self, u: &mut [f64], du: &[f64]) {
+        self.dofs.add_increment(u, du);
+    }
+    fn start_step(&mut self) {
+        for c in self.contacts.iter_mut() {
+            c.start_step();
+        }
+    }
+    fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
+        let Some(tol) = self.augmented_tolerance else { return false };
+        let mut again = false;
+        for c in self.contacts.iter_mut() {
+            if c.max_penetration() > tol {
+                c.augment();
+                again = true;
+            }
+        }
+        again
+    }
+    fn checkpoint(&mut self) {
+        self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone())).collect();
+    }
+    fn restore(&mut self) {
+        for (c, (lb, st)) in self.contacts.iter_mut().zip(&self.saved) {
+            c.lambda_bar.clone_from(lb);
+            c.state.clone_from(st);
+        }
+    }
+}

@@ -1,0 +1,271 @@
+//! Nonlinear solution: the [`NonlinearProblem`] interface a model offers, the [`NonlinearSolver`]
+//! interface a strategy implements, and [`NewtonRaphson`] with load stepping, automatic growth and
+//! cut-back of the load increment (paper eq. 4.13, with the active set updated at every iteration:
+//! the paper's trial-and-error loop, eqs. 4.14-4.15).
+
+use crate::error::{Result, StampError};
+use crate::linear_solver::LinearSolver;
+use faer::sparse::SparseColMatRef;
+use std::time::Instant;
+
+/// What one evaluation of the residual found.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Evaluation {
+    /// Euclidean norm of the residual over the equations.
+    pub residual_norm: f64,
+    /// The size of the forces in play (external, internal with reactions, contact), the scale the
+    /// residual is measured against.
+    pub force_scale: f64,
+    /// Contact points whose active state changed in this evaluation.
+    pub active_changes: usize,
+}
+
+/// A discretised problem R(u, t) = 0, t the load factor.
+pub trait NonlinearProblem {
+    /// Length of the full dof vector.
+    fn num_dofs(&self) -> usize;
+    /// Number of equations (free dofs).
+    fn num_equations(&self) -> usize;
+    /// Set the prescribed dofs of `u` for load factor `t`.
+    fn apply_prescribed(&self, u: &mut [f64], t: f64);
+    /// Evaluate the residual (and the tangent) at `u`, load factor `t`.
+    fn evaluate(&mut self, u: &[f64], t: f64, with_tangent: bool) -> Result<Evaluation>;
+    /// The residual of the last evaluation, per equation.
+    fn residual(&self) -> &[f64];
+    /// The tangent of the last evaluation with `with_tangent`.
+    fn matrix(&self) -> SparseColMatRef<'_, usize, f64>;
+    /// Add an increment given per equation.
+    fn add_increment(&self, u: &mut [f64], du: &[f64]);
+    /// Called before the first iteration of every load step.
+    fn start_step(&mut self) {}
+    /// Called after a load step converged. Returning true asks for the step to be solved again at
+    /// the same load (an augmented-Lagrangian update, say).
+    fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
+        false
+    }
+    /// Save the history-dependent state (contact) of the last converged step.
+    fn checkpoint(&mut self) {}
+    /// Go back to the last checkpoint (after a failed step).
+    fn restore(&mut self) {}
+}
+
+/// Settings of Newton-Raphson and of the load stepping.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct NewtonSettings {
+    /// Converged when |R| <= rel_tol * force scale + abs_tol and the active set did not change.
+    pub rel_tol: f64,
+    pub abs_tol: f64,
+    pub max_iterations: usize,
+    /// First load increment, as a fraction of the distance to the first target.
+    pub initial_increment: f64,
+    /// Largest load increment (in load factor).
+    pub max_increment: f64,
+    /// Smallest load increment before giving up.
+    pub min_increment: f64,
+    /// The increment grows by this factor after a step that took at most `easy_iterations`.
+    pub growth: f64,
+    pub easy_iterations: usize,
+    /// Most cut-backs in a row.
+    pub max_cutbacks: usize,
+    /// Most re-solves of one step requested by the problem (augmented Lagrangian).
+    pub max_restarts: usize,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        NewtonSettings {
+            rel_tol: 1e-10,
+            abs_tol: 1e-14,
+            max_iterations: 40,
+            initial_increment: 1.0,
+            max_increment: 1.0,
+            min_increment: 1e-6,
+            growth: 2.0,
+            easy_iterations: 5,
+            max_cutbacks: 12,
+            max_restarts: 20,
+        }
+    }
+}
+
+/// One converged load step.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StepReport {
+    pub step: usize,
+    pub load_factor: f64,
+    pub iterations: usize,
+    /// Residual norm at every iteration of the final (converged) attempt, the last one converged.
+    pub residual_history: Vec<f64>,
+    pub cutbacks: usize,
+    /// True when this step ends at one of the requested targets.
+    pub is_target: bool,
+    pub target_index: Option<usize>,
+}
+
+/// Summary of a whole solve.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct SolveSummary {
+    pub steps: usize,
+    pub newton_iterations: usize,
+    pub cutbacks: usize,
+    pub seconds: f64,
+}
+
+/// A strategy that drives a [`NonlinearProblem`] through a sequence of load factors.
+pub trait NonlinearSolver {
+    /// Solve from the converged state `u` at load factor `t0` through each of `targets` (increasing),
+    /// calling `on_step` after every converged step. On failure `u` holds the last converged state
+    /// and the error says where and why it stopped.
+    fn solve_path<P: NonlinearProblem>(
+        &mut self,
+        problem: &mut P,
+        u: &mut [f64],
+        t0: f64,
+        targets: &[f64],
+        on_step: &mut dyn FnMut(&StepReport, &[f64], &P),
+    ) -> Result<SolveSummary>;
+}
+
+/// Newton-Raphson with a direct linear solver, load stepping and cut-back.
+pub struct NewtonRaphson<L: LinearSolver> {
+    pub settings: NewtonSettings,
+    pub linear: L,
+    /// Called after every Newton iteration with (iteration, residual norm, force scale): for
+    /// progress bars.
+    pub on_iteration: Option<Box<dyn FnMut(usize, f64, f64)>>,
+}
+
+impl<L: LinearSolver> NewtonRaphson<L> {
+    pub fn new(linear: L, settings: NewtonSettings) -> Self {
+        NewtonRaphson { settings, linear, on_iteration: None }
+    }
+
+    /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history,
+    /// or the reason for failure.
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
+        let s = &self.settings;
+        let mut history = Vec::new();
+        let mut du = vec![0.0; p.num_equations()];
+        let mut first = f64::NAN;
+        for it in 0..=s.max_iterations {
+            let ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), f64::NAN, 0.0))?;
+            let tol = s.rel_tol * ev.force_scale + s.abs_tol;
+            history.push(ev.residual_norm);
+            if let Some(cb) = self.on_iteration.as_mut() {
+                cb(it, ev.residual_norm, ev.force_scale);
+            }
+            if !ev.residual_norm.is_finite() {
+                return Err(("the residual is not finite".into(), ev.residual_norm, tol));
+            }
+            if it == 0 {
+                first = ev.residual_norm.max(tol);
+            }
+            if ev.residual_norm <= tol && ev.active_changes == 0 {
+                return Ok(history);
+            }
+            if it == s.max_iterations {
+                return Err((format!("no convergence in {} iterations", s.max_iterations), ev.residual_norm, tol));
+            }
+            if ev.residual_norm > 1e10 * first {
+                return Err(("the residual diverged".into(), ev.residual_norm, tol));
+            }
+            du.copy_from_slice(p.residual());
+            self.linear.factorize(p.matrix()).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+            self.linear.solve_in_place(&mut du).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+            for x in du.iter_mut() {
+                *x = -*x;
+            }
+            p.add_increment(u, &du);
+        }
+        unreachable!()
+    }
+}
+
+impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
+    fn solve_path<P: NonlinearProblem>(
+        &mut self,
+        p: &mut P,
+        u: &mut [f64],
+        t0: f64,
+        targets: &[f64],
+        on_step: &mut dyn FnMut(&StepReport, &[f64], &P),
+    ) -> Result<SolveSummary> {
+        let start = Instant::now();
+        let mut summary = SolveSummary::default();
+        let mut t = t0;
+        let mut trial = u.to_vec();
+        let first_span = targets.first().map(|&x| (x - t0).abs()).unwrap_or(1.0);
+        let mut dt = (self.settings.initial_increment * first_span).min(self.settings.max_increment);
+        p.checkpoint();
+        for (ti, &target) in targets.iter().enumerate() {
+            if !target.is_finite() || target < t {
+                return Err(StampError::Problem(format!("load targets must increase: {target} after {t}")));
+            }
+            let mut cutbacks_in_row = 0;
+            while t < target {
+                let step_t = if t + dt >= target * (1.0 - 1e-12) { target } else { t + dt };
+                trial.copy_from_slice(u);
+                p.apply_prescribed(&mut trial, step_t);
+                p.start_step();
+                let mut restarts = 0;
+                let result = loop {
+                    match self.iterate(p, &mut trial, step_t) {
+                        Ok(h) => {
+                            if restarts < self.settings.max_restarts && p.end_step(&trial, step_t) {
+                                restarts += 1;
+                                summary.newton_iterations += h.len() - 1;
+                                continue;
+                            }
+                            break Ok(h);
+                        }
+                        Err(e) => break Err(e),
+                    }
+                };
+                match result {
+                    Ok(history) => {
+                        let iterations = history.len() - 1;
+                        summary.newton_iterations += iterations;
+                        summary.steps += 1;
+                        u.copy_from_slice(&trial);
+                        t = step_t;
+                        p.checkpoint();
+                        let is_target = step_t == target;
+                        let report = StepReport {
+                            step: summary.steps,
+                            load_factor: t,
+                            iterations,
+                            residual_history: history,
+                            cutbacks: cutbacks_in_row,
+                            is_target,
+                            target_index: is_target.then_some(ti),
+                        };
+                        on_step(&report, u, p);
+                        cutbacks_in_row = 0;
+                        if iterations <= self.settings.easy_iterations {
+                            dt = (dt * self.settings.growth).min(self.settings.max_increment);
+                        }
+                    }
+                    Err((reason, residual, tolerance)) => {
+                        p.restore();
+                        cutbacks_in_row += 1;
+                        summary.cutbacks += 1;
+                        dt *= 0.5;
+                        if cutbacks_in_row > self.settings.max_cutbacks || dt < self.settings.min_increment {
+                            summary.seconds = start.elapsed().as_secs_f64();
+                            return Err(StampError::NoConvergence {
+                                step: summary.steps + 1,
+                                load_factor: step_t,
+                                cutbacks: cutbacks_in_row - 1,
+                                residual,
+                                tolerance,
+                                reason: format!("{reason}; last converged load factor {t:.6e}"),
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        summary.seconds = start.elapsed().as_secs_f64();
+        Ok(summary)
+    }
+}

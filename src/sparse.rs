@@ -1,0 +1,178 @@
+//! The sparsity pattern of the global tangent, built once from the element connectivity, and the
+//! map from an element's local (row, column) dof pair to its slot in the compressed-column value
+//! array, so that every assembly refills values in place.
+//!
+//! Columns and rows are equations (free dofs). Equations are numbered node-major, so the rows of a
+//! column are the free dofs of the neighbouring nodes in node order: the slot of a local entry is
+//! `col_ptr[column] + block_start[(a, b)] + rank(dof of a)`, with no search.
+
+use crate::dofs::{DofMap, PRESCRIBED};
+use crate::error::{Result, StampError};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+
+/// The compressed-column pattern of the global matrix and the element-to-slot maps.
+pub struct SparsePattern {
+    symbolic: SymbolicSparseColMat<usize>,
+    /// For element e, `nodes_per_element^2` entries: offset of node a's rows inside the columns of
+    /// node b, at index e * npe^2 + b * npe + a.
+    block_start: Vec<u32>,
+    /// For every dof, the number of free components of its node that precede it.
+    rank: Vec<u8>,
+    nodes_per_element: usize,
+}
+
+impl SparsePattern {
+    /// Build the pattern of the matrix coupling all dofs of nodes that share an element.
+    pub fn new(dofs: &DofMap, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>) -> Result<Self> {
+        let nn = dofs.num_nodes();
+        let dpn = dofs.dofs_per_node();
+        let npe = nodes_per_element;
+        // node adjacency (each node is its own neighbour)
+        let mut count = vec![1usize; nn];
+        let mut conn = Vec::with_capacity(num_elements * npe);
+        for e in 0..num_elements {
+            let nodes = element_nodes(e);
+            if nodes.len() != npe {
+                return Err(StampError::Mesh(format!("element {e} has {} nodes, expected {npe}", nodes.len())));
+            }
+            for &a in &nodes {
+                if a >= nn {
+                    return Err(StampError::Mesh(format!("element {e} refers to node {a}, the model has {nn}")));
+                }
+                count[a] += npe - 1;
+            }
+            conn.extend_from_slice(&nodes);
+        }
+        let mut start = vec![0usize; nn + 1];
+        for i in 0..nn {
+            start[i + 1] = start[i] + count[i];
+        }
+        let mut adj = vec![0usize; start[nn]];
+        let mut fill = start.clone();
+        for i in 0..nn {
+            adj[fill[i]] = i;
+            fill[i] += 1;
+        }
+        for e in 0..num_elements {
+            let nodes = &conn[e * npe..(e + 1) * npe];
+            for &a in nodes {
+                for &b in nodes {
+                    if a != b {
+                        adj[fill[a]] = b;
+                        fill[a] += 1;
+                    }
+                }
+            }
+        }
+        // sort and deduplicate every node's neighbour list in place
+        let mut nbr_start = vec![0usize; nn + 1];
+        let mut nbr = Vec::with_capacity(adj.len() / 2);
+        for i in 0..nn {
+            let s = &mut adj[start[i]..start[i + 1]];
+            s.sort_unstable();
+            let mut last = usize::MAX;
+            for &b in s.iter() {
+                if b != last {
+                    nbr.push(b);
+                    last = b;
+                }
+            }
+            nbr_start[i + 1] = nbr.len();
+        }
+        drop(adj);
+        // free components per node and rank of each dof inside its node
+        let eqs = dofs.equations();
+        let mut free = vec![0u32; nn];
+        let mut rank = vec![0u8; nn * dpn];
+        for n in 0..nn {
+            let mut r = 0u8;
+            for c in 0..dpn {
+                rank[n * dpn + c] = r;
+                if eqs[n * dpn + c] != PRESCRIBED {
+                    r += 1;
+                }
+            }
+            free[n] = r as u32;
+        }
+        // column pointers and row indices
+        let neq = dofs.num_equations();
+        let mut col_ptr = Vec::with_capacity(neq + 1);
+        col_ptr.push(0usize);
+        let mut col_len_of_node = vec![0usize; nn];
+        for b in 0..nn {
+            col_len_of_node[b] = nbr[nbr_start[b]..nbr_start[b + 1]].iter().map(|&a| free[a] as usize).sum();
+        }
+        let nnz: usize = (0..nn).map(|b| col_len_of_node[b] * free[b] as usize).sum();
+        let mut row_idx = Vec::with_capacity(nnz);
+        for b in 0..nn {
+            for c in 0..dpn {
+                if eqs[b * dpn + c] == PRESCRIBED {
+                    continue;
+                }
+                for &a in &nbr[nbr_start[b]..nbr_start[b + 1]] {
+                    for ca in 0..dpn {
+                        let e = eqs[a * dpn + ca];
+                        if e != PRESCRIBED {
+                            row_idx.push(e as usize);
+                        }
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        debug_assert_eq!(col_ptr.len(), neq + 1);
+        // element block offsets
+        let mut block_start = vec![0u32; num_elements * npe * npe];
+        for e in 0..num_elements {
+            let nodes = &conn[e * npe..(e + 1) * npe];
+            for (bl, &b) in nodes.iter().enumerate() {
+                let list = &nbr[nbr_start[b]..nbr_start[b + 1]];
+                for (al, &a) in nodes.iter().enumerate() {
+                    let pos = list.binary_search(&a).expect("neighbour present by construction");
+                    let off: usize = list[..pos].iter().map(|&x| free[x] as usize).sum();
+                    block_start[e * npe * npe + bl * npe + al] = off as u32;
+                }
+            }
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(neq, neq, col_ptr, None, row_idx);
+        Ok(SparsePattern { symbolic, block_start, rank, nodes_per_element: npe })
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.symbolic.row_idx().len()
+    }
+
+    /// Number of equations (rows = columns).
+    pub fn size(&self) -> usize {
+        self.symbolic.ncols()
+    }
+
+    /// The symbolic matrix.
+    pub fn symbolic(&self) -> &SymbolicSparseColMat<usize> {
+        &self.symbolic
+    }
+
+    /// A matrix view of `values` in this pattern.
+    pub fn matrix<'a>(&'a self, values: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
+        SparseColMatRef::new(self.symbolic.as_ref(), values)
+    }
+
+    /// Slot in the value array of the entry (row = dof `row_dof` at local node `a`, column = dof
+    /// `col_dof` with equation `col_eq` at local node `b`) of element `e`.
+    #[inline]
+    pub fn slot(&self, e: usize, a: usize, b: usize, row_dof: usize, col_eq: usize) -> usize {
+        let npe = self.nodes_per_element;
+        self.symbolic.col_ptr()[col_eq] + self.block_start[e * npe * npe + b * npe + a] as usize + self.rank[row_dof] as usize
+    }
+
+    /// Slot of the diagonal-block entry (row dof, column dof) at one node, for contributions that
+    /// couple only the dofs of a single node (nodal contact). `None` when either dof is prescribed.
+    pub fn nodal_slot(&self, dofs: &DofMap, row_dof: usize, col_dof: usize) -> Option<usize> {
+        let ce = dofs.equation(col_dof)?;
+        let re = dofs.equation(row_dof)?;
+        let col = self.symbolic.col_ptr()[ce]..self.symbolic.col_ptr()[ce + 1];
+        let rows = &self.symbolic.row_idx()[col.clone()];
+        rows.binary_search(&re).ok().map(|p| col.start + p)
+    }
+}
