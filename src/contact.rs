@@ -67,10 +67,12 @@ pub struct ContactPair {
     pub state: Vec<PointState>,
     /// How often each point changed between active and inactive during the current load step.
     pub flips: Vec<u32>,
-    /// Points held in their state because they cycled (see [`ContactPair::max_flips`]).
-    pub frozen: Vec<Option<bool>>,
-    /// After this many changes inside one load step a point is frozen in its current state for the
-    /// rest of the step (cycling guard).
+    /// Points that cycled in this step (see [`ContactPair::max_flips`]).
+    pub frozen: Vec<bool>,
+    /// After this many changes of state inside one load step a point stops counting as a change
+    /// and keeps the active-side tangent for the rest of the step, with its force still exact
+    /// (lambda = min(0, lambda_bar + eps Psi)): a damped Newton step at the kink that ends the
+    /// cycling and converges to the exact (non-adhesive) solution.
     pub max_flips: u32,
 }
 
@@ -87,7 +89,7 @@ impl ContactPair {
             lambda_bar: vec![0.0; n],
             state: vec![PointState::default(); n],
             flips: vec![0; n],
-            frozen: vec![None; n],
+            frozen: vec![false; n],
             max_flips: 4,
         }
     }
@@ -95,7 +97,7 @@ impl ContactPair {
     /// Forget the cycling history (at the start of a load step).
     pub fn start_step(&mut self) {
         self.flips.fill(0);
-        self.frozen.fill(None);
+        self.frozen.fill(false);
     }
 
     /// Evaluate Psi, the multipliers and the active set at the full displacement vector `u` and
@@ -122,23 +124,21 @@ impl ContactPair {
                 }
             };
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
-            let mut active = trial < 0.0;
-            if let Some(f) = self.frozen[k] {
-                active = f;
-            }
+            // touching points (Psi = 0) start in the active set
+            let active = trial <= 0.0;
             let was = self.state[k].active;
-            if active != was {
+            if active != was && !self.frozen[k] {
                 changes += 1;
                 self.flips[k] += 1;
-                if self.flips[k] >= self.max_flips && self.frozen[k].is_none() {
-                    // cycling: hold the point in contact; at the kink lambda ~ 0 either way
-                    self.frozen[k] = Some(true);
-                    active = true;
+                if self.flips[k] >= self.max_flips {
+                    // cycling at the kink: from now on in this step the point keeps the tangent of
+                    // the active side, while its force stays exact (no adhesion)
+                    self.frozen[k] = true;
                 }
             }
             let lambda = if active { trial } else { 0.0 };
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
-            if !active {
+            if !active && !self.frozen[k] {
                 continue;
             }
             let w = p.weight;

@@ -1,0 +1,2 @@
+//! The problems and reports behind the `stamp` command-line program.
+pub mod paper;
