@@ -67,6 +67,8 @@ pub struct ContactPair {
     pub state: Vec<PointState>,
     /// How often each point changed between active and inactive during the current load step.
     pub flips: Vec<u32>,
+    /// Active flags at the last evaluation with a tangent (line-search probes do not count).
+    pub last_active: Vec<bool>,
     /// Points that cycled in this step (see [`ContactPair::max_flips`]).
     pub frozen: Vec<bool>,
     /// After this many changes of state inside one load step a point stops counting as a change
@@ -90,6 +92,7 @@ impl ContactPair {
             state: vec![PointState::default(); n],
             flips: vec![0; n],
             frozen: vec![false; n],
+            last_active: vec![false; n],
             max_flips: 4,
         }
     }
@@ -107,6 +110,9 @@ impl ContactPair {
     pub fn evaluate(&mut self, u: &[f64], t: f64, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>) -> usize {
         let d = Vector3::from(self.motion) * t;
         let mut changes = 0;
+        let with_tangent = add_tangent.is_some();
+        // a cycling point keeps the active-side tangent only near the kink
+        let band = 1e-2 * self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
         for (k, p) in self.points.iter().enumerate() {
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
@@ -126,8 +132,8 @@ impl ContactPair {
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
             // touching points (Psi = 0) start in the active set
             let active = trial <= 0.0;
-            let was = self.state[k].active;
-            if active != was && !self.frozen[k] {
+            let was = self.last_active[k];
+            if with_tangent && active != was && !self.frozen[k] {
                 changes += 1;
                 self.flips[k] += 1;
                 if self.flips[k] >= self.max_flips {
@@ -136,9 +142,12 @@ impl ContactPair {
                     self.frozen[k] = true;
                 }
             }
+            if with_tangent {
+                self.last_active[k] = active;
+            }
             let lambda = if active { trial } else { 0.0 };
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
-            if !active && !self.frozen[k] {
+            if !active && !(self.frozen[k] && with_tangent && trial <= band) {
                 continue;
             }
             let w = p.weight;

@@ -36,7 +36,7 @@ pub struct Model<E: Element> {
     values: Vec<f64>,
     residual: Vec<f64>,
     energy: f64,
-    saved: Vec<(Vec<f64>, Vec<PointState>)>,
+    saved: Vec<(Vec<f64>, Vec<PointState>, Vec<bool>)>,
     pub timings: ModelTimings,
 }
 
@@ -188,12 +188,13 @@ impl<E: Element> NonlinearProblem for Model<E> {
         again
     }
     fn checkpoint(&mut self) {
-        self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone())).collect();
+        self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone(), c.last_active.clone())).collect();
     }
     fn restore(&mut self) {
-        for (c, (lb, st)) in self.contacts.iter_mut().zip(&self.saved) {
+        for (c, (lb, st, la)) in self.contacts.iter_mut().zip(&self.saved) {
             c.lambda_bar.clone_from(lb);
             c.state.clone_from(st);
+            c.last_active.clone_from(la);
         }
     }
 }

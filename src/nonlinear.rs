@@ -64,6 +64,8 @@ pub struct NewtonSettings {
     pub disp_tol: f64,
     pub loose_tol: f64,
     pub max_iterations: usize,
+    /// Most halvings of the Newton correction in the line search (0: plain Newton).
+    pub line_search_steps: usize,
     /// First load increment, as a fraction of the distance to the first target.
     pub initial_increment: f64,
     /// Largest load increment (in load factor).
@@ -87,7 +89,8 @@ impl Default for NewtonSettings {
             floor_tol: 1e-8,
             disp_tol: 1e-12,
             loose_tol: 1e-6,
-            max_iterations: 40,
+            max_iterations: 25,
+            line_search_steps: 0,
             initial_increment: 1.0,
             max_increment: 1.0,
             min_increment: 1e-6,
@@ -194,6 +197,26 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                 *x = -*x;
             }
             last_correction = du.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            // backtracking line search on |R|: keeps a far-off predictor from pushing the body deep
+            // into the punch (and the active set from swinging wholesale)
+            let r0 = ev.residual_norm;
+            let mut alpha = 1.0;
+            let mut trial = if s.line_search_steps > 0 { u.to_vec() } else { Vec::new() };
+            for _ in 0..s.line_search_steps {
+                trial.copy_from_slice(u);
+                let scaled: Vec<f64> = du.iter().map(|x| alpha * x).collect();
+                p.add_increment(&mut trial, &scaled);
+                let r = p.evaluate(&trial, t, false).map(|e| e.residual_norm).unwrap_or(f64::INFINITY);
+                if r.is_finite() && r <= (1.0 - 1e-4 * alpha) * r0 {
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            if alpha < 1.0 {
+                for x in du.iter_mut() {
+                    *x *= alpha.max(0.5f64.powi(s.line_search_steps as i32));
+                }
+            }
             p.add_increment(u, &du);
         }
         unreachable!()

@@ -48,7 +48,9 @@ fn check_finite_scalar(shape: &str, what: &str, value: f64) -> Result<f64> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(StampError::Problem(format!("{shape}: the {what} must be finite, got {value}")))
+        Err(StampError::Problem(format!(
+            "{shape}: the {what} must be finite, got {value}"
+        )))
     }
 }
 
@@ -59,7 +61,9 @@ fn unit_direction(shape: &str, what: &str, v: &Vector3<f64>) -> Result<Vector3<f
     check_finite_vector(shape, what, v)?;
     let m = v.amax();
     if m == 0.0 {
-        return Err(StampError::Problem(format!("{shape}: the {what} must not be the zero vector")));
+        return Err(StampError::Problem(format!(
+            "{shape}: the {what} must not be the zero vector"
+        )));
     }
     Ok((v / m).normalize())
 }

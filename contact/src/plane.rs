@@ -69,6 +69,10 @@ impl ContactSurface for Plane {
     }
 
     fn describe(&self) -> String {
-        format!("rigid half-space behind the plane through {} with outward normal {}", fmt_vec(&self.point), fmt_vec(&self.normal))
+        format!(
+            "rigid half-space behind the plane through {} with outward normal {}",
+            fmt_vec(&self.point),
+            fmt_vec(&self.normal)
+        )
     }
 }
