@@ -7,6 +7,7 @@
 //! [`nonlinear::NonlinearSolver`].
 
 pub mod error;
+pub mod io;
 pub mod mesh;
 pub mod surface;
 
