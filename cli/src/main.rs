@@ -1,15 +1,52 @@
-use stamp_cli::paper::run_paper;
-fn main() {
-    match run_paper() {
-        Ok(r) => {
-            for row in &r.table1 {
-                println!("T1 P={} lin [{}, {}] v3={:.4} ({:+.3}%)  nl [{}, {}] v3={:.4} ({:+.3}%) act={:?}", row.p, row.linear.b_int, row.linear.b_ext, row.linear.v3, 100.0*row.linear.v3_rel_diff, row.nonlinear.b_int, row.nonlinear.b_ext, row.nonlinear.v3, 100.0*row.nonlinear.v3_rel_diff, row.nonlinear.active_set);
-            }
-            for row in &r.table2 {
-                println!("T2 P={} [{}, {}] v3={:.4} ({:+.3}%) reaction {:.10} it {}", row.p, row.b_int, row.b_ext, row.v3, 100.0*row.v3_rel_diff, row.reaction, row.newton_iterations);
-            }
-            println!("{:.3} s", r.seconds);
+//! `stamp`: elastic plates pressed by rigid punches. With no arguments it runs the paper's benchmark.
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "stamp", version, about = "Finite elements for elastic plates in contact with rigid punches (Kulikov & Plotnikova's mixed plate)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Reproduce the paper's section-5 benchmark: Tables 1 and 2 and the reaction check.
+    Paper {
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Redraw the paper's Figure 4 (contact pressure along the plate, R = 100) into this folder.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Solve the problem a TOML problem file describes; write VTK, summary.json and CSV files.
+    Run {
+        /// The problem file (see meshes/*.toml).
+        problem: PathBuf,
+        /// Output folder (default: next to the problem file, named after it).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => stamp_cli::report::paper_command(false, None),
+        Some(Command::Paper { json, plot }) => stamp_cli::report::paper_command(json, plot.as_deref()),
+        Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
         }
-        Err(e) => { eprintln!("error: {e}"); std::process::exit(1) }
     }
 }
