@@ -63,6 +63,11 @@ pub struct NewtonSettings {
     /// cannot be smaller than the round-off of Psi times the contact stiffness.
     pub disp_tol: f64,
     pub loose_tol: f64,
+    /// Also converged when |R| stopped decreasing and the energy of the last correction, |du . R|,
+    /// fell below energy_tol times
+    /// that of the first (the classical energy criterion; immune to round-off in stiff modes such
+    /// as the thickness stretch of a very thin plate, whose conditioning grows like (l/h)^4).
+    pub energy_tol: f64,
     pub max_iterations: usize,
     /// Most halvings of the Newton correction in the line search (0: plain Newton).
     pub line_search_steps: usize,
@@ -89,6 +94,7 @@ impl Default for NewtonSettings {
             floor_tol: 1e-8,
             disp_tol: 1e-12,
             loose_tol: 1e-6,
+            energy_tol: 1e-12,
             max_iterations: 25,
             line_search_steps: 0,
             initial_increment: 1.0,
@@ -162,12 +168,14 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         let mut du = vec![0.0; p.num_equations()];
         let mut first = f64::NAN;
         let mut last_correction = f64::INFINITY;
+        let mut first_energy = f64::NAN;
+        let mut last_energy = f64::INFINITY;
         for it in 0..=s.max_iterations {
             let ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), f64::NAN, 0.0))?;
             let tol = s.rel_tol * ev.force_scale + s.abs_tol;
             history.push(ev.residual_norm);
             if std::env::var_os("STAMP_DEBUG").is_some() {
-                eprintln!("t={t:.6e} it={it} |R|={:.3e} scale={:.3e} changes={}", ev.residual_norm, ev.force_scale, ev.active_changes);
+                eprintln!("t={t:.6e} it={it} |R|={:.3e} scale={:.3e} changes={} energy={:.3e}/{:.3e}", ev.residual_norm, ev.force_scale, ev.active_changes, last_energy, first_energy);
             }
             if let Some(cb) = self.on_iteration.as_mut() {
                 cb(it, ev.residual_norm, ev.force_scale);
@@ -181,7 +189,8 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             let stalled = it > 0 && ev.residual_norm > 0.5 * history[history.len() - 2];
             let u_max = u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let fixed = last_correction <= s.disp_tol * u_max && ev.residual_norm <= s.loose_tol * ev.force_scale;
-            if ev.active_changes == 0 && (ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || fixed) {
+            let energy = it > 1 && stalled && last_energy <= s.energy_tol * first_energy && ev.residual_norm <= 1e2 * s.loose_tol * ev.force_scale;
+            if ev.active_changes == 0 && (ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || fixed || energy) {
                 return Ok(history);
             }
             if it == s.max_iterations {
@@ -197,6 +206,10 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                 *x = -*x;
             }
             last_correction = du.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            last_energy = du.iter().zip(p.residual()).map(|(a, b)| a * b).sum::<f64>().abs();
+            if it == 0 {
+                first_energy = last_energy;
+            }
             // backtracking line search on |R|: keeps a far-off predictor from pushing the body deep
             // into the punch (and the active set from swinging wholesale)
             let r0 = ev.residual_norm;

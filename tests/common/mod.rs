@@ -54,3 +54,41 @@ pub fn plate(mesh: &QuadMesh, h: f64, kin: Kinematics) -> PlateElements {
 pub fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
+
+use stamp::dofs::DofMap;
+use stamp::linear_solver::SparseLu;
+use stamp::model::Model;
+use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver, StepReport};
+use stamp_elements::Face;
+
+/// A cantilever strip along x2 (length l, one element across a unit width, plane strain v1 = 0),
+/// clamped at x2 = 0, with a conservative force `force` per unit width in x3 at the free end, at the
+/// mid-surface. Returns (tip deflection w, tip horizontal displacement u2, the step reports).
+pub fn cantilever_strip(l: f64, h: f64, elements: usize, force: f64, kin: Kinematics, steps: &[f64]) -> (f64, f64, Vec<StepReport>) {
+    let mesh = QuadMesh::rectangle(0.0, 1.0, 0.0, l, 1, elements).unwrap();
+    let section = Section::homogeneous(h, Isotropic::new(2.0e5, 0.3).unwrap()).unwrap();
+    let plate = PlateElements::new(&mesh, section, kin).unwrap();
+    let mut dofs = DofMap::new(mesh.num_nodes(), 6).unwrap();
+    let all: Vec<usize> = (0..mesh.num_nodes()).collect();
+    dofs.fix(&all, &[0, 3]).unwrap();
+    dofs.fix(mesh.group_nodes("bottom").unwrap(), &[0, 1, 2, 3, 4, 5]).unwrap();
+    let mut model = Model::new(plate, dofs).unwrap();
+    let tip = mesh.group_nodes("top").unwrap().to_vec();
+    for &n in &tip {
+        model.add_load(Face::Bottom.dof(n, 2), 0.25 * force).unwrap();
+        model.add_load(Face::Top.dof(n, 2), 0.25 * force).unwrap();
+    }
+    let mut settings = NewtonSettings::default();
+    settings.max_increment = 1.0;
+    let mut newton = NewtonRaphson::new(SparseLu::new(), settings);
+    let mut u = vec![0.0; model.dofs.num_dofs()];
+    let mut reports = Vec::new();
+    newton.solve_path(&mut model, &mut u, 0.0, steps, &mut |r, _, _| reports.push(r.clone())).unwrap();
+    let mid = |c: usize| tip.iter().map(|&n| 0.5 * (u[Face::Bottom.dof(n, c)] + u[Face::Top.dof(n, c)])).sum::<f64>() / tip.len() as f64;
+    (mid(2), mid(1), reports)
+}
+
+/// Plate bending stiffness E h^3 / (12 (1 - nu^2)) of the test material.
+pub fn bending_stiffness(h: f64) -> f64 {
+    2.0e5 * h * h * h / (12.0 * (1.0 - 0.09))
+}
