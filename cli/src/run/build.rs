@@ -1,0 +1,270 @@
+//! From a parsed problem to a [`Model`]: section, plate elements, constraints, loads and punches.
+//!
+//! Conventions:
+//! * Constraints: `fix` holds components at zero, `prescribe` sets them to value * load factor; the
+//!   shorthand `simply_supported` holds v3- and v3+ (the whole normal fibre is held vertically,
+//!   rotations are free; in-plane motions must be restrained by other conditions), `clamped` all
+//!   six, `symmetry_x1` v1- and v1+ (a symmetry plane with normal x1), `symmetry_x2` v2- and v2+.
+//!   `plate.plane_strain = true` holds v1- = v1+ = 0 at every node.
+//! * Loads are dead loads (fixed direction, reference geometry), scaled by the load factor.
+//!   `line`: force per unit length along a curve group, each segment of length L gives F L / 2 to
+//!   each end node; `surface`: force per unit area, `pressure`: p > 0 pushes on the face towards the
+//!   plate (-x3 on the top face, +x3 on the bottom face), both with the consistent nodal weights
+//!   int N_a dA over the group's cells (exact for a constant load on bilinear elements); `point`: the
+//!   force at every node of the group. `face = "mid"` (default) puts half on each face.
+//! * Punches: the candidate points are the nodes of `group` (default: all) on the touched face
+//!   (x3 = delta+ for `top`, delta- for `bottom`), weighted by their tributary area over the group's
+//!   cells when the group is a surface, over the whole mesh otherwise.
+//! * Automatic eps_reg: the penalty stiffness of a contact point per unit area and unit penetration
+//!   is k = eps_reg |grad Psi|^2 (q_n = -lambda |grad Psi| = eps_reg |grad Psi|^2 g for a penetration
+//!   g = -Psi / |grad Psi|). We choose k = 100 E h / l_e^2, l_e the square root of the mean cell
+//!   area: a node's contact spring k l_e^2 is 100 times the membrane stiffness E h of the plate
+//!   around it. |grad Psi| on the punch surface is 2R for a cylinder or sphere and 1 for a plane,
+//!   so eps_reg = 100 E h / (l_e^2 |grad Psi|^2). The penetration is then about q_n l_e^2 / (100 E h).
+
+use super::mesh::{group_error, MeshData};
+use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Problem, PunchFace, Shape};
+use nalgebra::Vector3;
+use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
+use stamp::dofs::DofMap;
+use stamp::model::Model;
+use stamp::nonlinear::NewtonSettings;
+use stamp::surface::ContactSurface;
+use stamp::{Result, StampError};
+use stamp_contact::{Cylinder, Plane, Sphere};
+use stamp_elements::{Face, Isotropic, Kinematics, PlateElements, Section};
+use std::sync::Arc;
+
+/// Factor c of the automatic eps_reg (see the module notes).
+pub const AUTO_EPS_FACTOR: f64 = 100.0;
+
+/// What the output needs to know about a punch.
+pub struct PunchInfo {
+    pub name: String,
+    pub face: Face,
+    /// Reference x3 of the touched face.
+    pub z: f64,
+    pub surface: Arc<dyn ContactSurface>,
+    pub eps_reg: f64,
+    pub eps_automatic: bool,
+}
+
+/// A model ready to solve and what the outputs need.
+pub struct Setup {
+    pub mesh: MeshData,
+    pub model: Model<PlateElements>,
+    pub section: Section,
+    pub punches: Vec<PunchInfo>,
+    pub targets: Vec<f64>,
+    pub settings: NewtonSettings,
+}
+
+fn face_of(f: PunchFace) -> Face {
+    match f {
+        PunchFace::Top => Face::Top,
+        PunchFace::Bottom => Face::Bottom,
+    }
+}
+
+/// Spread a nodal force over the faces.
+fn add_force(model: &mut Model<PlateElements>, node: usize, f: [f64; 3], face: LoadFace) -> Result<()> {
+    for c in 0..3 {
+        if f[c] == 0.0 {
+            continue;
+        }
+        match face {
+            LoadFace::Mid => {
+                model.add_load(Face::Bottom.dof(node, c), 0.5 * f[c])?;
+                model.add_load(Face::Top.dof(node, c), 0.5 * f[c])?;
+            }
+            LoadFace::Top => model.add_load(Face::Top.dof(node, c), f[c])?,
+            LoadFace::Bottom => model.add_load(Face::Bottom.dof(node, c), f[c])?,
+        }
+    }
+    Ok(())
+}
+
+/// Build everything the solve needs.
+pub fn build(p: &Problem) -> Result<Setup> {
+    let s = &p.spec;
+    let mesh = MeshData::load(p)?;
+    let n_nodes = mesh.mesh.num_nodes();
+
+    // plate
+    let ps = s.plate.get_ref();
+    let material = Isotropic::new(ps.young.0, ps.nu.0).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
+    let (dm, dp) = match ps.thickness {
+        Some(h) => (-0.5 * h.0, 0.5 * h.0),
+        None => (ps.delta_minus.unwrap().0, ps.delta_plus.unwrap().0),
+    };
+    let section = Section::homogeneous_offset(dm, dp, material).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
+    let kin = match ps.kinematics {
+        KinematicsSpec::Nonlinear => Kinematics::Nonlinear,
+        KinematicsSpec::Linear => Kinematics::Linear,
+    };
+    let plate = PlateElements::new(&mesh.mesh, section.clone(), kin)?;
+
+    // constraints
+    let mut dofs = DofMap::new(n_nodes, 6)?;
+    if ps.plane_strain {
+        let all: Vec<usize> = (0..n_nodes).collect();
+        dofs.fix(&all, &[0, 3])?;
+    }
+    for (i, b) in s.boundary.iter().enumerate() {
+        let bs = b.get_ref();
+        let key = format!("boundary[{i}].group");
+        let name = bs.group.get_ref();
+        let nodes = mesh.nodes(name).ok_or_else(|| group_error(p, bs.group.span(), &key, name, "", &mesh))?;
+        let comps: Vec<usize> = bs.fix.iter().flat_map(|d| d.components.clone()).collect();
+        dofs.fix(&nodes, &comps).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}]"), e))?;
+        for (k, v) in &bs.prescribe {
+            let comps = super::problem::dof_components(&k.0).expect("checked word");
+            for &n in &nodes {
+                for &c in &comps {
+                    dofs.prescribe(n, c, v.0).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}].prescribe"), e))?;
+                }
+            }
+        }
+    }
+    let mut model = Model::new(plate, dofs).map_err(|e| StampError::Input { file: p.path.display().to_string(), message: e.to_string() })?;
+
+    // loads
+    for (i, l) in s.load.iter().enumerate() {
+        let ls = l.get_ref();
+        let key = format!("load[{i}].group");
+        let name = ls.group.get_ref();
+        let face = ls.face.unwrap_or_default();
+        match ls.kind {
+            LoadKind::Line => {
+                let segs = mesh.curves.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "curve", &mesh))?;
+                let f = ls.force.unwrap().0;
+                for s in segs {
+                    let (a, b) = (mesh.mesh.coords[s[0]], mesh.mesh.coords[s[1]]);
+                    let len = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                    for &n in s {
+                        add_force(&mut model, n, f.map(|x| 0.5 * len * x), face)?;
+                    }
+                }
+            }
+            LoadKind::Surface | LoadKind::Pressure => {
+                let cells = mesh.surfaces.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "surface", &mesh))?;
+                let f = match ls.kind {
+                    LoadKind::Surface => ls.force.unwrap().0,
+                    _ => {
+                        let q = ls.pressure.unwrap().0;
+                        if face == LoadFace::Top { [0.0, 0.0, -q] } else { [0.0, 0.0, q] }
+                    }
+                };
+                let w = mesh.nodal_areas_of(cells);
+                for (n, &a) in w.iter().enumerate() {
+                    if a > 0.0 {
+                        add_force(&mut model, n, f.map(|x| a * x), face)?;
+                    }
+                }
+            }
+            LoadKind::Point => {
+                let nodes = mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "", &mesh))?;
+                for n in nodes {
+                    add_force(&mut model, n, ls.force.unwrap().0, face)?;
+                }
+            }
+        }
+    }
+
+    // punches
+    let young = ps.young.0;
+    let h = section.thickness();
+    let le = mesh.element_size();
+    let mut punches = Vec::new();
+    let mut tolerance: Option<f64> = None;
+    for (i, pu) in s.punch.iter().enumerate() {
+        let spec = pu.get_ref();
+        let name = p.punch_name(i);
+        let key = format!("punch[{i}]");
+        let wrap = |e: StampError| p.error_at(pu.span(), &key, e);
+        let (surface, grad_norm): (Arc<dyn ContactSurface>, f64) = match spec.shape {
+            Shape::Cylinder => {
+                let r = spec.radius.unwrap().0;
+                (Arc::new(Cylinder::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.axis.unwrap().0), r).map_err(wrap)?), 2.0 * r)
+            }
+            Shape::Sphere => {
+                let r = spec.radius.unwrap().0;
+                (Arc::new(Sphere::new(Vector3::from(spec.center.unwrap().0), r).map_err(wrap)?), 2.0 * r)
+            }
+            Shape::Plane => (Arc::new(Plane::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.normal.unwrap().0)).map_err(wrap)?), 1.0),
+        };
+        let face = face_of(spec.face);
+        let z = match face {
+            Face::Top => section.delta_plus,
+            Face::Bottom => section.delta_minus,
+        };
+        let (nodes, weights) = match &spec.group {
+            None => ((0..n_nodes).collect::<Vec<_>>(), mesh.mesh.nodal_areas()),
+            Some(g) => {
+                let gname = g.get_ref();
+                let nodes = mesh.nodes(gname).ok_or_else(|| group_error(p, g.span(), &format!("{key}.group"), gname, "", &mesh))?;
+                let w = match mesh.surfaces.get(gname) {
+                    Some(cells) => mesh.nodal_areas_of(cells),
+                    None => mesh.mesh.nodal_areas(),
+                };
+                (nodes, w)
+            }
+        };
+        let points: Vec<ContactPoint> = nodes
+            .iter()
+            .map(|&n| {
+                let x = mesh.mesh.coords[n];
+                ContactPoint { node: n, x_ref: [x[0], x[1], z], dofs: [0, 1, 2].map(|c| face.dof(n, c)), weight: weights[n] }
+            })
+            .collect();
+        let (eps_reg, eps_automatic) = match spec.eps_reg {
+            Some(e) => (e.0, false),
+            None => (AUTO_EPS_FACTOR * young * h / (le * le * grad_norm * grad_norm), true),
+        };
+        let ck = match spec.kinematics {
+            Some(ContactKinematicsSpec::Exact) => ContactKinematics::Exact,
+            Some(ContactKinematicsSpec::Shallow) => ContactKinematics::Shallow { direction: [0.0, 0.0, 1.0] },
+            None => match kin {
+                Kinematics::Nonlinear => ContactKinematics::Exact,
+                Kinematics::Linear => ContactKinematics::Shallow { direction: [0.0, 0.0, 1.0] },
+            },
+        };
+        let mut pair = ContactPair::new(name.clone(), surface.clone(), points, eps_reg, ck);
+        pair.motion = spec.motion.map(|m| m.0).unwrap_or([0.0; 3]);
+        model.contacts.push(pair);
+        if let Some(t) = spec.penetration_tolerance {
+            tolerance = Some(tolerance.map_or(t.0, |x: f64| x.min(t.0)));
+        }
+        punches.push(PunchInfo { name, face, z, surface, eps_reg, eps_automatic });
+    }
+    model.augmented_tolerance = tolerance;
+
+    // solver
+    let sv = &s.solver;
+    let mut settings = NewtonSettings { max_increment: 0.25, ..NewtonSettings::default() };
+    if let Some(x) = sv.max_increment {
+        settings.max_increment = x.0;
+    }
+    if let Some(x) = sv.initial_increment {
+        settings.initial_increment = x.0;
+    }
+    if let Some(x) = sv.min_increment {
+        settings.min_increment = x.0;
+    }
+    if let Some(x) = sv.rel_tol {
+        settings.rel_tol = x.0;
+    }
+    if let Some(x) = sv.abs_tol {
+        settings.abs_tol = x.0;
+    }
+    if let Some(x) = sv.max_iterations {
+        settings.max_iterations = x;
+    }
+    if let Some(x) = sv.max_cutbacks {
+        settings.max_cutbacks = x;
+    }
+    if let Some(x) = sv.line_search_steps {
+        settings.line_search_steps = x;
+    }
+    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings })
+}

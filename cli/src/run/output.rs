@@ -1,0 +1,329 @@
+//! What `stamp run` writes for every converged load step: the point and cell fields of the .vtu,
+//! the summary.json entry and the contact-pressure CSV, all computed from the displacement vector
+//! and the model's contact state.
+//!
+//! Point data: `displacement` = mid-surface (v- + v+)/2, `displacement_bottom` = v-,
+//! `displacement_top` = v+ (3-vectors); `lambda` (the multiplier, <= 0 in contact, force per unit
+//! reference area), `contact_pressure` q_n = -lambda |grad Psi| >= 0, `gap` = Psi / |grad Psi| of the
+//! face each punch touches (the smallest over the punches; written only when there are punches),
+//! `active` (1 in the active set), `loaded` (1 where |lambda| > loaded_threshold * max |lambda| of
+//! that punch). A node that is a candidate of several punches gets the sum of their lambda and q_n.
+//!
+//! Cell data (element centre = mean over the 2 x 2 Gauss points of the element's assumed resultants;
+//! for the nonlinear plate these are second Piola-Kirchhoff resultants per unit reference length):
+//! with T+- = int S N+- dx3, N+- the linear through-thickness shape functions,
+//! * membrane forces `N11`, `N22`, `N12` = T- + T+ (since N- + N+ = 1, this is int S dx3);
+//! * bending moments `M11`, `M22`, `M12` = int S (x3 - x_m) dx3 about the mid-surface
+//!   x_m = (delta- + delta+)/2: N+ - N- = (2 x3 - delta- - delta+)/h = 2 (x3 - x_m)/h, so
+//!   M = (h/2)(T+ - T-) for any section (positive when the top fibre is in tension);
+//! * transverse shear forces `Q1` = T13- + T13+, `Q2` = T23- + T23+;
+//! * the transverse normal force `T33` = int S33 dx3.
+
+use super::build::PunchInfo;
+use super::mesh::MeshData;
+use nalgebra::Vector3;
+use serde::Serialize;
+use stamp::element::Element;
+use stamp::io::Field;
+use stamp::model::Model;
+use stamp_elements::{Face, PlateElements, Section};
+use std::collections::BTreeMap;
+
+/// Names of the point arrays of every .vtu (gap only with punches).
+pub const POINT_ARRAYS: [&str; 8] = ["displacement", "displacement_bottom", "displacement_top", "lambda", "contact_pressure", "gap", "active", "loaded"];
+/// Names of the cell arrays of every .vtu.
+pub const CELL_ARRAYS: [&str; 9] = ["N11", "N22", "N12", "M11", "M22", "M12", "Q1", "Q2", "T33"];
+
+/// Bounding box of reference coordinates (x1, x2, x3 of the touched face).
+#[derive(Debug, Clone, Serialize)]
+pub struct BBox {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+impl BBox {
+    fn of(points: &[[f64; 3]]) -> Option<BBox> {
+        let first = points.first()?;
+        let mut b = BBox { min: *first, max: *first };
+        for p in points {
+            for i in 0..3 {
+                b.min[i] = b.min[i].min(p[i]);
+                b.max[i] = b.max[i].max(p[i]);
+            }
+        }
+        Some(b)
+    }
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct PointOut {
+    /// Mid-surface displacement (v- + v+)/2, averaged over the group's nodes.
+    pub displacement: [f64; 3],
+    pub displacement_bottom: [f64; 3],
+    pub displacement_top: [f64; 3],
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct PunchOut {
+    /// Total force of this punch on the plate.
+    pub reaction: [f64; 3],
+    pub active_nodes: usize,
+    pub loaded_nodes: usize,
+    pub loaded_zone: Option<BBox>,
+    pub max_penetration: f64,
+    pub max_pressure: f64,
+    pub eps_reg: f64,
+}
+
+/// One converged step of summary.json.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepEntry {
+    pub step: usize,
+    pub load_factor: f64,
+    pub is_target: bool,
+    pub converged: bool,
+    pub newton_iterations: usize,
+    pub cutbacks: usize,
+    pub residual_history: Vec<f64>,
+    /// Nodes in the active set of any punch.
+    pub active_nodes: usize,
+    pub loaded_nodes: usize,
+    /// Reference coordinates of the loaded nodes (null when no node carries load).
+    pub loaded_zone: Option<BBox>,
+    /// Total contact force on the plate (all punches).
+    pub reaction: [f64; 3],
+    pub max_penetration: f64,
+    pub points: BTreeMap<String, PointOut>,
+    pub punches: BTreeMap<String, PunchOut>,
+    /// The .vtu of this step (relative to the output folder), if written.
+    pub vtu: Option<String>,
+    pub csv: Vec<String>,
+}
+
+/// Everything computed for one step.
+pub struct StepData {
+    pub entry: StepEntry,
+    pub point_fields: Vec<Field>,
+    pub cell_fields: Vec<Field>,
+    /// Per punch: CSV text and the rows (node, q_n).
+    pub punch_rows: Vec<Vec<ContactRow>>,
+}
+
+/// One row of the contact CSV.
+#[derive(Debug, Clone, Copy)]
+pub struct ContactRow {
+    pub node: usize,
+    pub x: [f64; 2],
+    pub deformed: [f64; 3],
+    pub q_n: f64,
+    pub lambda: f64,
+    pub active: bool,
+}
+
+fn face_disp(u: &[f64], n: usize, face: Face) -> [f64; 3] {
+    [0, 1, 2].map(|c| u[face.dof(n, c)])
+}
+
+fn mid_disp(u: &[f64], n: usize) -> [f64; 3] {
+    let (b, t) = (face_disp(u, n, Face::Bottom), face_disp(u, n, Face::Top));
+    [0, 1, 2].map(|c| 0.5 * (b[c] + t[c]))
+}
+
+/// Stress resultants at the element centres.
+pub fn cell_fields(model: &Model<PlateElements>, section: &Section, u: &[f64]) -> Vec<Field> {
+    let plate = &model.element;
+    let mut ws = plate.new_workspace();
+    let ne = plate.num_elements();
+    let half_h = 0.5 * section.thickness();
+    let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(ne); 9];
+    let mut local = vec![0.0; 24];
+    for e in 0..ne {
+        for (a, &n) in plate.element_nodes(e).iter().enumerate() {
+            local[6 * a..6 * a + 6].copy_from_slice(&u[6 * n..6 * n + 6]);
+        }
+        let gs = plate.gauss_state(e, &local, &mut ws);
+        let mut t = [0.0; 11];
+        for g in 0..4 {
+            for r in 0..11 {
+                t[r] += 0.25 * gs.resultant[g][r];
+            }
+        }
+        let vals = [
+            t[0] + t[1],
+            t[2] + t[3],
+            t[4] + t[5],
+            half_h * (t[1] - t[0]),
+            half_h * (t[3] - t[2]),
+            half_h * (t[5] - t[4]),
+            t[6] + t[7],
+            t[8] + t[9],
+            t[10],
+        ];
+        for (k, v) in vals.iter().enumerate() {
+            out[k].push(*v);
+        }
+    }
+    CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect()
+}
+
+/// Inputs of [`step_data`] that do not change from step to step.
+pub struct Context<'a> {
+    pub mesh: &'a MeshData,
+    pub punches: &'a [PunchInfo],
+    pub section: &'a Section,
+    pub threshold: f64,
+    /// Point groups reported in summary.json.
+    pub point_groups: &'a [(String, Vec<usize>)],
+}
+
+/// Fields, summary entry and CSV rows of the state `u` at load factor `t`.
+pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, report: &stamp::nonlinear::StepReport) -> StepData {
+    let n = cx.mesh.mesh.num_nodes();
+    let coords = &cx.mesh.mesh.coords;
+    let mut lambda = vec![0.0; n];
+    let mut pressure = vec![0.0; n];
+    let mut active = vec![0.0; n];
+    let mut loaded = vec![0.0; n];
+    let mut gap = vec![f64::INFINITY; n];
+    let mut reaction = [0.0; 3];
+    let mut max_pen = 0.0f64;
+    let mut punches = BTreeMap::new();
+    let mut loaded_pts = Vec::new();
+    let mut punch_rows = Vec::new();
+    for (info, pair) in cx.punches.iter().zip(&model.contacts) {
+        let q = pair.pressures();
+        let lam_max = pair.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
+        let mut candidate = vec![false; n];
+        let mut p_loaded = Vec::new();
+        let mut rows = Vec::with_capacity(pair.points.len());
+        let mut n_active = 0;
+        for (k, (pt, st)) in pair.points.iter().zip(&pair.state).enumerate() {
+            let node = pt.node;
+            candidate[node] = true;
+            lambda[node] += st.lambda;
+            pressure[node] += q[k];
+            let g = Vector3::from(st.grad).norm();
+            if g > 0.0 {
+                gap[node] = gap[node].min(st.psi / g);
+            }
+            if st.active {
+                active[node] = 1.0;
+                n_active += 1;
+            }
+            if lam_max > 0.0 && st.lambda.abs() > cx.threshold * lam_max {
+                loaded[node] = 1.0;
+                p_loaded.push(pt.x_ref);
+            }
+            let d = face_disp(u, node, info.face);
+            rows.push(ContactRow {
+                node,
+                x: coords[node],
+                deformed: [pt.x_ref[0] + d[0], pt.x_ref[1] + d[1], pt.x_ref[2] + d[2]],
+                q_n: q[k],
+                lambda: st.lambda,
+                active: st.active,
+            });
+        }
+        // gap of the nodes that are not candidates: the exact gap of the touched face
+        let shift = Vector3::from(pair.motion) * t;
+        for node in 0..n {
+            if candidate[node] {
+                continue;
+            }
+            let d = face_disp(u, node, info.face);
+            let x = Vector3::new(coords[node][0] + d[0], coords[node][1] + d[1], info.z + d[2]) - shift;
+            let g = info.surface.gradient(&x).norm();
+            if g > 0.0 {
+                gap[node] = gap[node].min(info.surface.psi(&x) / g);
+            }
+        }
+        let r = pair.reaction();
+        for i in 0..3 {
+            reaction[i] += r[i];
+        }
+        let pen = pair.max_penetration();
+        max_pen = max_pen.max(pen);
+        punches.insert(
+            info.name.clone(),
+            PunchOut {
+                reaction: r,
+                active_nodes: n_active,
+                loaded_nodes: p_loaded.len(),
+                loaded_zone: BBox::of(&p_loaded),
+                max_penetration: pen,
+                max_pressure: q.iter().cloned().fold(0.0, f64::max),
+                eps_reg: pair.eps_reg,
+            },
+        );
+        loaded_pts.extend(p_loaded);
+        punch_rows.push(rows);
+    }
+    let mut point_fields = vec![
+        Field::new("displacement", 3, (0..n).flat_map(|k| mid_disp(u, k)).collect()),
+        Field::new("displacement_bottom", 3, (0..n).flat_map(|k| face_disp(u, k, Face::Bottom)).collect()),
+        Field::new("displacement_top", 3, (0..n).flat_map(|k| face_disp(u, k, Face::Top)).collect()),
+        Field::scalar("lambda", lambda),
+        Field::scalar("contact_pressure", pressure),
+    ];
+    if !cx.punches.is_empty() {
+        let big = gap.iter().cloned().filter(|g| g.is_finite()).fold(0.0, f64::max);
+        point_fields.push(Field::scalar("gap", gap.iter().map(|&g| if g.is_finite() { g } else { big }).collect()));
+    }
+    point_fields.push(Field::scalar("active", active.clone()));
+    point_fields.push(Field::scalar("loaded", loaded.clone()));
+    let points = cx
+        .point_groups
+        .iter()
+        .map(|(name, nodes)| {
+            let avg = |f: &dyn Fn(usize) -> [f64; 3]| {
+                let mut s = [0.0; 3];
+                for &k in nodes {
+                    let v = f(k);
+                    for i in 0..3 {
+                        s[i] += v[i] / nodes.len() as f64;
+                    }
+                }
+                s
+            };
+            (
+                name.clone(),
+                PointOut {
+                    displacement: avg(&|k| mid_disp(u, k)),
+                    displacement_bottom: avg(&|k| face_disp(u, k, Face::Bottom)),
+                    displacement_top: avg(&|k| face_disp(u, k, Face::Top)),
+                },
+            )
+        })
+        .collect();
+    let entry = StepEntry {
+        step: report.step,
+        load_factor: t,
+        is_target: report.is_target,
+        converged: true,
+        newton_iterations: report.iterations,
+        cutbacks: report.cutbacks,
+        residual_history: report.residual_history.clone(),
+        active_nodes: active.iter().filter(|&&a| a > 0.0).count(),
+        loaded_nodes: loaded.iter().filter(|&&a| a > 0.0).count(),
+        loaded_zone: BBox::of(&loaded_pts),
+        reaction,
+        max_penetration: max_pen,
+        points,
+        punches,
+        vtu: None,
+        csv: Vec::new(),
+    };
+    StepData { entry, point_fields, cell_fields: cell_fields(model, cx.section, u), punch_rows }
+}
+
+/// The contact CSV of one punch: one row per candidate node, in the order given.
+pub fn contact_csv(rows: &[ContactRow]) -> String {
+    let mut s = String::from("node,x1,x2,x1_deformed,x2_deformed,x3_deformed,q_n,lambda,active\n");
+    for r in rows {
+        s.push_str(&format!(
+            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{}\n",
+            r.node, r.x[0], r.x[1], r.deformed[0], r.deformed[1], r.deformed[2], r.q_n, r.lambda, r.active as u8
+        ));
+    }
+    s
+}

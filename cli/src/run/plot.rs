@@ -1,0 +1,127 @@
+//! Line plots with plotters, written as PNG and SVG. Text uses an embedded DejaVu Sans (font/,
+//! Bitstream Vera licence) through plotters' `ab_glyph` backend, so no system fonts are needed.
+//! Files are drawn to a hidden temporary file (PNG) or a string (SVG) and renamed or written
+//! atomically.
+
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+use stamp::io::write_string_atomically;
+use stamp::{Result, StampError};
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+static FONT: Once = Once::new();
+const FONT_NAME: &str = "stamp-sans";
+
+fn register_font() {
+    FONT.call_once(|| {
+        // the font is compiled in and valid: a failure here is a build defect, reported by draw errors
+        let _ = plotters::style::register_font(FONT_NAME, FontStyle::Normal, include_bytes!("font/DejaVuSans.ttf"));
+    });
+}
+
+/// One curve.
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A plot description.
+pub struct Plot<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub series: &'a [Series],
+}
+
+fn plot_err(path: &Path, e: impl std::fmt::Display) -> StampError {
+    StampError::Input { file: path.display().to_string(), message: format!("cannot draw the plot: {e}") }
+}
+
+fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for x in v.filter(|x| x.is_finite()) {
+        lo = lo.min(x);
+        hi = hi.max(x);
+    }
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    if hi - lo <= 1e-12 * hi.abs().max(lo.abs()).max(1e-300) {
+        let d = hi.abs().max(1.0) * 0.5;
+        return (lo - d, hi + d);
+    }
+    let pad = 0.03 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, plotters::coord::Shift>, p: &Plot) -> std::result::Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (x0, x1) = range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)));
+    let (mut y0, y1) = range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.1)));
+    if y0 > 0.0 {
+        y0 = 0.0;
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption(p.title, (FONT_NAME, 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(p.x_label)
+        .y_desc(p.y_label)
+        .label_style((FONT_NAME, 15))
+        .axis_desc_style((FONT_NAME, 17))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for (k, s) in p.series.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        chart
+            .draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(2)))
+            .map_err(|e| e.to_string())?
+            .label(s.label.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+    }
+    if p.series.len() > 1 || p.series.iter().any(|s| !s.label.is_empty()) {
+        chart
+            .configure_series_labels()
+            .label_font((FONT_NAME, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    root.present().map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// Draw `p` into `<stem>.png` and `<stem>.svg`. Returns the two paths.
+pub fn write_plot(stem: &Path, p: &Plot) -> Result<[PathBuf; 2]> {
+    register_font();
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    // SVG into a string, written atomically
+    let mut text = String::new();
+    draw(SVGBackend::with_string(&mut text, (900, 600)).into_drawing_area(), p).map_err(|e| plot_err(&svg, e))?;
+    write_string_atomically(&svg, &text)?;
+    // PNG into a hidden temporary file next to the target, renamed over it
+    let name = png.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = png.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
+    let drawn = draw(BitMapBackend::new(&tmp, (900, 600)).into_drawing_area(), p);
+    if let Err(e) = drawn {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(plot_err(&png, e));
+    }
+    std::fs::rename(&tmp, &png).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        StampError::io(&png, e)
+    })?;
+    Ok([png, svg])
+}
