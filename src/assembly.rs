@@ -84,6 +84,7 @@ impl Assembler {
         for color in &self.colors {
             energy += color
                 .par_iter()
+                .with_min_len(256)
                 .fold(
                     || (element.new_workspace(), LocalSystem::new(nloc), vec![0.0; nloc], vec![0usize; nloc], 0.0f64),
                     |(mut ws, mut local, mut ue, mut gdof, mut en), &e| {

@@ -69,6 +69,12 @@ pub struct ContactPair {
     pub flips: Vec<u32>,
     /// Active flags at the last evaluation with a tangent (line-search probes do not count).
     pub last_active: Vec<bool>,
+    /// Keep the active set fixed during Newton iterations and update it only through
+    /// [`update_active_set`](Self::update_active_set) (the paper's trial and error). When false the
+    /// set follows every iterate (semi-smooth Newton).
+    pub hold_active_set: bool,
+    /// The active set was initialised from a first evaluation (points with Psi <= 0).
+    pub initialized: bool,
     /// Points that cycled in this step (see [`ContactPair::max_flips`]).
     pub frozen: Vec<bool>,
     /// After this many changes of state inside one load step a point stops counting as a change
@@ -93,6 +99,8 @@ impl ContactPair {
             flips: vec![0; n],
             frozen: vec![false; n],
             last_active: vec![false; n],
+            hold_active_set: false,
+            initialized: false,
             max_flips: 4,
         }
     }
@@ -111,7 +119,7 @@ impl ContactPair {
         let d = Vector3::from(self.motion) * t;
         let mut changes = 0;
         let with_tangent = add_tangent.is_some();
-        // a cycling point keeps the active-side tangent only near the kink
+        let first = !self.initialized;
         let band = 1e-2 * self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
         for (k, p) in self.points.iter().enumerate() {
             let x_ref = Vector3::from(p.x_ref);
@@ -130,24 +138,35 @@ impl ContactPair {
                 }
             };
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
-            // touching points (Psi = 0) start in the active set
-            let active = trial <= 0.0;
-            let was = self.last_active[k];
-            if with_tangent && active != was && !self.frozen[k] {
-                changes += 1;
-                self.flips[k] += 1;
-                if self.flips[k] >= self.max_flips {
-                    // cycling at the kink: from now on in this step the point keeps the tangent of
-                    // the active side, while its force stays exact (no adhesion)
-                    self.frozen[k] = true;
+            // touching points (Psi = 0) belong to the active set
+            let wanted = trial <= 0.0;
+            if !self.initialized {
+                self.last_active[k] = wanted;
+            }
+            let active = if self.hold_active_set {
+                // the paper's trial and error: the set stays fixed while Newton converges on it
+                if with_tangent && wanted != self.last_active[k] && !self.frozen[k] {
+                    changes += 1;
                 }
-            }
-            if with_tangent {
-                self.last_active[k] = active;
-            }
+                self.last_active[k]
+            } else {
+                if with_tangent && wanted != self.last_active[k] && !self.frozen[k] {
+                    changes += 1;
+                    self.flips[k] += 1;
+                    if self.flips[k] >= self.max_flips {
+                        self.frozen[k] = true;
+                    }
+                }
+                if with_tangent {
+                    self.last_active[k] = wanted;
+                }
+                wanted
+            };
             let lambda = if active { trial } else { 0.0 };
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
-            if !active && !(self.frozen[k] && with_tangent && trial <= band) {
+            // a point that cycled keeps the active-side tangent near the kink (its force stays exact)
+            let near_kink = !self.hold_active_set && self.frozen[k] && with_tangent && trial <= band;
+            if !active && !near_kink {
                 continue;
             }
             let w = p.weight;
@@ -163,6 +182,32 @@ impl ContactPair {
                     for j in 0..3 {
                         add(p.dofs[i], p.dofs[j], kt[(i, j)]);
                     }
+                }
+            }
+        }
+        if first {
+            self.initialized = true;
+        }
+        changes
+    }
+
+    /// The paper's active-set update (eqs. 4.14b, 4.15a) after Newton converged on a fixed set: add
+    /// the points with Psi < 0, drop those with lambda > 0. A point that changes `max_flips` times
+    /// in one load step is held where it is (it sits at the kink, lambda ~ 0 either way). Returns the
+    /// number of changes.
+    pub fn update_active_set(&mut self) -> usize {
+        let mut changes = 0;
+        for k in 0..self.points.len() {
+            if self.frozen[k] {
+                continue;
+            }
+            let wanted = self.lambda_bar[k] + self.eps_reg * self.state[k].psi <= 0.0;
+            if wanted != self.last_active[k] {
+                self.last_active[k] = wanted;
+                changes += 1;
+                self.flips[k] += 1;
+                if self.flips[k] >= self.max_flips {
+                    self.frozen[k] = true;
                 }
             }
         }

@@ -171,6 +171,9 @@ impl<E: Element> NonlinearProblem for Model<E> {
     fn add_increment(&self, u: &mut [f64], du: &[f64]) {
         self.dofs.add_increment(u, du);
     }
+    fn update_active_set(&mut self) -> usize {
+        self.contacts.iter_mut().map(|c| c.update_active_set()).sum()
+    }
     fn start_step(&mut self) {
         for c in self.contacts.iter_mut() {
             c.start_step();

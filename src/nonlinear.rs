@@ -36,6 +36,11 @@ pub trait NonlinearProblem {
     fn matrix(&self) -> SparseColMatRef<'_, usize, f64>;
     /// Add an increment given per equation.
     fn add_increment(&self, u: &mut [f64], du: &[f64]);
+    /// Update any inequality constraints' active sets after Newton converged on them; returns the
+    /// number of changes (0: the solution stands).
+    fn update_active_set(&mut self) -> usize {
+        0
+    }
     /// Called before the first iteration of every load step.
     fn start_step(&mut self) {}
     /// Called after a load step converged. Returning true asks for the step to be solved again at
@@ -190,11 +195,21 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             let u_max = u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let fixed = last_correction <= s.disp_tol * u_max && ev.residual_norm <= s.loose_tol * ev.force_scale;
             let energy = it > 1 && stalled && last_energy <= s.energy_tol * first_energy && ev.residual_norm <= 1e2 * s.loose_tol * ev.force_scale;
-            if ev.active_changes == 0 && (ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || fixed || energy) {
-                return Ok(history);
+            if ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || fixed || energy {
+                if ev.active_changes == 0 {
+                    return Ok(history);
+                }
+                if p.update_active_set() > 0 && it < s.max_iterations {
+                    // converged on the old set: re-solve with the new one
+                    last_energy = f64::INFINITY;
+                    first_energy = f64::NAN;
+                    last_correction = f64::INFINITY;
+                    continue;
+                }
             }
             if it == s.max_iterations {
-                return Err((format!("no convergence in {} iterations", s.max_iterations), ev.residual_norm, tol));
+                let why = if ev.active_changes > 0 { " (the active set kept changing)" } else { "" };
+                return Err((format!("no convergence in {} iterations{why}", s.max_iterations), ev.residual_norm, tol));
             }
             if ev.residual_norm > 1e30 * first {
                 return Err(("the residual diverged".into(), ev.residual_norm, tol));
@@ -207,7 +222,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             }
             last_correction = du.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             last_energy = du.iter().zip(p.residual()).map(|(a, b)| a * b).sum::<f64>().abs();
-            if it == 0 {
+            if first_energy.is_nan() {
                 first_energy = last_energy;
             }
             // backtracking line search on |R|: keeps a far-off predictor from pushing the body deep
@@ -232,7 +247,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             }
             p.add_increment(u, &du);
         }
-        unreachable!()
+        Err(("no convergence".into(), f64::NAN, 0.0))
     }
 }
 
@@ -304,7 +319,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         p.restore();
                         cutbacks_in_row += 1;
                         summary.cutbacks += 1;
-                        dt *= 0.5;
+                        dt = 0.5 * (step_t - t);
                         if cutbacks_in_row > self.settings.max_cutbacks || dt < self.settings.min_increment {
                             summary.seconds = start.elapsed().as_secs_f64();
                             return Err(StampError::NoConvergence {
