@@ -12,11 +12,11 @@ pub fn format_report(r: &PaperReport) -> String {
     let mut s = String::new();
     s.push_str("stamp: the paper's section-5 benchmark (half plate, 40 elements, plane strain)\n\n");
     s.push_str("Table 1. R = 1000 mm (shallow), P/2 on each end. Zones [b_int, b_ext] in mm: ours (paper); v3(l) in mm: ours, paper, difference\n");
-    s.push_str(&format!("{:>5} | {:^17} {:>8} {:>7} {:>9} | {:^17} {:>8} {:>7} {:>9}\n", "P", "linear zone", "v3", "paper", "diff", "nonlinear zone", "v3", "paper", "diff"));
+    s.push_str(&format!("{:>5} | {:^25} {:>8} {:>7} {:>9} | {:^25} {:>8} {:>7} {:>9}\n", "P", "linear zone", "v3", "paper", "diff", "nonlinear zone", "v3", "paper", "diff"));
     for row in &r.table1 {
-        let zone = |z: &crate::paper::ZoneRow| format!("[{:>4.1}, {:>4.1}] ({:.1}, {:.1})", z.b_int, z.b_ext, z.paper[0], z.paper[1]);
+        let zone = |z: &crate::paper::ZoneRow| format!("[{:>4.1}, {:>4.1}] ({:>4.1}, {:>4.1})", z.b_int, z.b_ext, z.paper[0], z.paper[1]);
         s.push_str(&format!(
-            "{:>5.1} | {:<17} {:>8.4} {:>7.3} {:>9} | {:<17} {:>8.4} {:>7.3} {:>9}\n",
+            "{:>5.1} | {:<25} {:>8.4} {:>7.3} {:>9} | {:<25} {:>8.4} {:>7.3} {:>9}\n",
             row.p,
             zone(&row.linear),
             row.linear.v3,
