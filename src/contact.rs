@@ -101,7 +101,7 @@ impl ContactPair {
             last_active: vec![false; n],
             hold_active_set: false,
             initialized: false,
-            max_flips: 4,
+            max_flips: 10,
         }
     }
 
