@@ -105,7 +105,7 @@ impl Default for NewtonSettings {
             initial_increment: 1.0,
             max_increment: 1.0,
             min_increment: 1e-6,
-            growth: 2.0,
+            growth: 1.5,
             easy_iterations: 5,
             max_cutbacks: 12,
             max_restarts: 20,
