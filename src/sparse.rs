@@ -43,6 +43,11 @@ impl SparsePattern {
             }
             conn.extend_from_slice(&nodes);
         }
+        if let Some(orphan) = (0..nn).find(|&i| count[i] == 1) {
+            return Err(StampError::Mesh(format!(
+                "node {orphan} belongs to no element, so nothing holds it (a stray point in the mesh file?)"
+            )));
+        }
         let mut start = vec![0usize; nn + 1];
         for i in 0..nn {
             start[i + 1] = start[i] + count[i];

@@ -65,3 +65,13 @@ fn newton_failure_names_the_step_and_the_residual() {
     assert!(text.contains("load step 1") && text.contains("residual"), "{text}");
     assert!(u.iter().all(|x| *x == 0.0), "u keeps the last converged state");
 }
+
+#[test]
+fn a_node_outside_every_element_is_named() {
+    let coords = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]];
+    let mesh = QuadMesh::new(coords, vec![[0, 1, 2, 3]]).unwrap();
+    let plate = PlateElements::new(&mesh, steel_section(0.1), Kinematics::Linear).unwrap();
+    let dofs = DofMap::new(mesh.num_nodes(), 6).unwrap();
+    let err = Model::new(plate, dofs).err().expect("an orphan node is an error");
+    assert!(err.to_string().contains("node 4 belongs to no element"), "{err}");
+}
