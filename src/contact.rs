@@ -140,7 +140,7 @@ impl ContactPair {
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
             // touching points (Psi = 0) belong to the active set
             let wanted = trial <= 0.0;
-            if !self.initialized {
+            if first {
                 self.last_active[k] = wanted;
             }
             let active = if self.hold_active_set {
@@ -152,10 +152,7 @@ impl ContactPair {
             } else {
                 if with_tangent && wanted != self.last_active[k] && !self.frozen[k] {
                     changes += 1;
-                    self.flips[k] += 1;
-                    if self.flips[k] >= self.max_flips {
-                        self.frozen[k] = true;
-                    }
+                    record_flip(&mut self.flips[k], &mut self.frozen[k], self.max_flips);
                 }
                 if with_tangent {
                     self.last_active[k] = wanted;
@@ -205,10 +202,7 @@ impl ContactPair {
             if wanted != self.last_active[k] {
                 self.last_active[k] = wanted;
                 changes += 1;
-                self.flips[k] += 1;
-                if self.flips[k] >= self.max_flips {
-                    self.frozen[k] = true;
-                }
+                record_flip(&mut self.flips[k], &mut self.frozen[k], self.max_flips);
             }
         }
         changes
@@ -235,6 +229,17 @@ impl ContactPair {
             .fold(0.0, f64::max)
     }
 
+    /// Euclidean norm of the nodal contact forces w lambda grad Psi (the size of the forces in play,
+    /// whether or not they cancel in the total).
+    pub fn force_norm(&self) -> f64 {
+        self.points
+            .iter()
+            .zip(&self.state)
+            .map(|(p, s)| (p.weight * s.lambda).powi(2) * Vector3::from(s.grad).norm_squared())
+            .sum::<f64>()
+            .sqrt()
+    }
+
     /// Total force of the punch on the body, sum of -w lambda grad Psi.
     pub fn reaction(&self) -> [f64; 3] {
         let mut r = [0.0; 3];
@@ -249,5 +254,13 @@ impl ContactPair {
     /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point.
     pub fn pressures(&self) -> Vec<f64> {
         self.state.iter().map(|s| -s.lambda * Vector3::from(s.grad).norm()).collect()
+    }
+}
+
+/// Count one change of state of a point; after `max_flips` changes in a load step it is frozen.
+fn record_flip(flips: &mut u32, frozen: &mut bool, max_flips: u32) {
+    *flips += 1;
+    if *flips >= max_flips {
+        *frozen = true;
     }
 }

@@ -175,11 +175,13 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         let mut last_correction = f64::INFINITY;
         let mut first_energy = f64::NAN;
         let mut last_energy = f64::INFINITY;
+        let debug = std::env::var_os("STAMP_DEBUG").is_some();
+        let mut scaled = if s.line_search_steps > 0 { vec![0.0; du.len()] } else { Vec::new() };
         for it in 0..=s.max_iterations {
             let ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), f64::NAN, 0.0))?;
             let tol = s.rel_tol * ev.force_scale + s.abs_tol;
             history.push(ev.residual_norm);
-            if std::env::var_os("STAMP_DEBUG").is_some() {
+            if debug {
                 eprintln!("t={t:.6e} it={it} |R|={:.3e} scale={:.3e} changes={} energy={:.3e}/{:.3e}", ev.residual_norm, ev.force_scale, ev.active_changes, last_energy, first_energy);
             }
             if let Some(cb) = self.on_iteration.as_mut() {
@@ -232,7 +234,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             let mut trial = if s.line_search_steps > 0 { u.to_vec() } else { Vec::new() };
             for _ in 0..s.line_search_steps {
                 trial.copy_from_slice(u);
-                let scaled: Vec<f64> = du.iter().map(|x| alpha * x).collect();
+                for (d, x) in scaled.iter_mut().zip(&du) {
+                    *d = alpha * x;
+                }
                 p.add_increment(&mut trial, &scaled);
                 let r = p.evaluate(&trial, t, false).map(|e| e.residual_norm).unwrap_or(f64::INFINITY);
                 if r.is_finite() && r <= (1.0 - 1e-4 * alpha) * r0 {
