@@ -1,20 +1,10 @@
 //! `stamp run meshes/paper-r100.toml` through the library entry point: the paper's Table 2 (last row)
 //! through the generic problem-file path, and the files it writes.
 
+mod common;
+use common::*;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("stamp-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn vec3(v: &Value) -> [f64; 3] {
     let a = v.as_array().expect("a 3-vector");

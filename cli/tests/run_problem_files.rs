@@ -1,17 +1,12 @@
 //! Problem files: bad input gives errors that name the file, the key or group and the line; the
 //! built-in rectangle, line and pressure loads and the failure path of `stamp run`.
 
+mod common;
+use common::*;
 use serde_json::Value;
 use std::path::PathBuf;
 use std::process::Command;
 use stamp_cli::run::{build::build, Problem};
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("stamp-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// A cantilever strip (Table 1's first row): plane strain, clamped at x2 = 0, an end force F per
 /// unit width at x2 = 100, no punch.

@@ -1,18 +1,8 @@
 //! The sphere example of meshes/ through `stamp run`, and the redrawn Figure 4 of the paper.
 
+mod common;
+use common::*;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("stamp-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn f(v: &Value) -> f64 {
     v.as_f64().unwrap()
