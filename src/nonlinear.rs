@@ -138,7 +138,7 @@ pub struct SolveSummary {
 
 /// A strategy that drives a [`NonlinearProblem`] through a sequence of load factors.
 pub trait NonlinearSolver {
-    /// Solve from the converged state `u` at load factor `t0` through each of `targets` (increasing),
+    /// Solve from the converged state `u` at load factor `t0` through each of `targets` in turn (up or down: loading, then unloading),
     /// calling `on_step` after every converged step. On failure `u` holds the last converged state
     /// and the error says where and why it stopped.
     fn solve_path<P: NonlinearProblem>(
@@ -272,12 +272,14 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         let mut dt = (self.settings.initial_increment * first_span).min(self.settings.max_increment);
         p.checkpoint();
         for (ti, &target) in targets.iter().enumerate() {
-            if !target.is_finite() || target < t {
-                return Err(StampError::Problem(format!("load targets must increase: {target} after {t}")));
+            if !target.is_finite() {
+                return Err(StampError::Problem(format!("load target {target} is not a finite number")));
             }
+            // Targets may go up or down (loading, then unloading): step towards each in turn.
             let mut cutbacks_in_row = 0;
-            while t < target {
-                let step_t = if t + dt >= target * (1.0 - 1e-12) { target } else { t + dt };
+            while t != target {
+                let remaining = target - t;
+                let step_t = if dt >= remaining.abs() * (1.0 - 1e-12) { target } else { t + dt.copysign(remaining) };
                 trial.copy_from_slice(u);
                 p.apply_prescribed(&mut trial, step_t);
                 p.start_step();
@@ -323,7 +325,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         p.restore();
                         cutbacks_in_row += 1;
                         summary.cutbacks += 1;
-                        dt = 0.5 * (step_t - t);
+                        dt = 0.5 * (step_t - t).abs();
                         if cutbacks_in_row > self.settings.max_cutbacks || dt < self.settings.min_increment {
                             summary.seconds = start.elapsed().as_secs_f64();
                             return Err(StampError::NoConvergence {
