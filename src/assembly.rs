@@ -45,6 +45,9 @@ unsafe impl Send for SharedMut {}
 unsafe impl Sync for SharedMut {}
 
 /// Assembles one element set into a pattern. Built once per model; reused for every assembly.
+/// Element count below which the assembly runs on the calling thread.
+pub const PARALLEL_MIN_ELEMENTS: usize = 2048;
+
 pub struct Assembler {
     colors: Vec<Vec<usize>>,
 }
@@ -69,11 +72,17 @@ impl Assembler {
         let dpn = dofs.dofs_per_node();
         let npe = element.nodes_per_element();
         let nloc = dpn * npe;
-        force.par_iter_mut().for_each(|f| *f = 0.0);
+        // below this many elements a fork-join costs more than it saves
+        let parallel = element.num_elements() >= PARALLEL_MIN_ELEMENTS && rayon::current_num_threads() > 1;
+        force.fill(0.0);
         let with_tangent = values.is_some();
         let vals_ptr = match values {
             Some(v) => {
-                v.par_iter_mut().for_each(|x| *x = 0.0);
+                if parallel {
+                    v.par_iter_mut().for_each(|x| *x = 0.0);
+                } else {
+                    v.fill(0.0);
+                }
                 SharedMut(v.as_mut_ptr())
             }
             None => SharedMut(std::ptr::null_mut()),
@@ -81,54 +90,63 @@ impl Assembler {
         let force_ptr = SharedMut(force.as_mut_ptr());
         let eqs = dofs.equations();
         let mut energy = 0.0;
-        for color in &self.colors {
-            energy += color
-                .par_iter()
-                .with_min_len(256)
-                .fold(
-                    || (element.new_workspace(), LocalSystem::new(nloc), vec![0.0; nloc], vec![0usize; nloc], 0.0f64),
-                    |(mut ws, mut local, mut ue, mut gdof, mut en), &e| {
-                        let nodes = element.element_nodes(e);
-                        for (a, &n) in nodes.iter().enumerate() {
-                            for c in 0..dpn {
-                                gdof[a * dpn + c] = n * dpn + c;
-                                ue[a * dpn + c] = u[n * dpn + c];
-                            }
+        let init = || (element.new_workspace(), LocalSystem::new(nloc), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc]);
+        // per-thread scratch: workspace, local system, local values, global dofs, row ranks
+        let kernel = |st: &mut (E::Workspace, LocalSystem, Vec<f64>, Vec<usize>, Vec<u32>), e: usize| -> f64 {
+                let (ws, local, ue, gdof, rank) = st;
+                let nodes = element.element_nodes(e);
+                for (a, &n) in nodes.iter().enumerate() {
+                    for c in 0..dpn {
+                        gdof[a * dpn + c] = n * dpn + c;
+                        ue[a * dpn + c] = u[n * dpn + c];
+                    }
+                }
+                local.clear();
+                element.evaluate(e, ue, ws, local, with_tangent);
+                // SAFETY: elements of one colour share no node, so they write disjoint
+                // entries of `force` and of the value array.
+                unsafe {
+                    let fp = force_ptr;
+                    for i in 0..nloc {
+                        *fp.0.add(gdof[i]) += local.residual[i];
+                    }
+                    if with_tangent {
+                        let vp = vals_ptr;
+                        // slot of (row dof i, column j) = column start + block offset of
+                        // (node of i, node of j) + rank of i among its node's free dofs
+                        for (a, r) in rank.iter_mut().enumerate() {
+                            *r = if eqs[gdof[a]] == crate::dofs::PRESCRIBED { u32::MAX } else { pattern.rank(gdof[a]) };
                         }
-                        local.clear();
-                        element.evaluate(e, &ue, &mut ws, &mut local, with_tangent);
-                        en += local.energy;
-                        // SAFETY: elements of one colour share no node, so they write disjoint
-                        // entries of `force` and of the value array.
-                        unsafe {
-                            let fp = force_ptr;
-                            for i in 0..nloc {
-                                *fp.0.add(gdof[i]) += local.residual[i];
+                        for j in 0..nloc {
+                            let ce = eqs[gdof[j]];
+                            if ce == crate::dofs::PRESCRIBED {
+                                continue;
                             }
-                            if with_tangent {
-                                let vp = vals_ptr;
-                                for j in 0..nloc {
-                                    let ce = eqs[gdof[j]];
-                                    if ce == crate::dofs::PRESCRIBED {
-                                        continue;
-                                    }
-                                    let b = j / dpn;
-                                    for i in 0..nloc {
-                                        if eqs[gdof[i]] == crate::dofs::PRESCRIBED {
-                                            continue;
-                                        }
-                                        let a = i / dpn;
-                                        let s = pattern.slot(e, a, b, gdof[i], ce as usize);
-                                        *vp.0.add(s) += local.tangent[i * nloc + j];
+                            let b = j / dpn;
+                            for a in 0..npe {
+                                let base = pattern.block_slot(e, a, b, ce as usize);
+                                for i in a * dpn..(a + 1) * dpn {
+                                    if rank[i] != u32::MAX {
+                                        *vp.0.add(base + rank[i] as usize) += local.tangent[i * nloc + j];
                                     }
                                 }
                             }
                         }
-                        (ws, local, ue, gdof, en)
-                    },
-                )
-                .map(|t| t.4)
-                .sum::<f64>();
+                    }
+                }
+                local.energy
+            };
+        if !parallel {
+            let mut state = init();
+            for color in &self.colors {
+                for &e in color {
+                    energy += kernel(&mut state, e);
+                }
+            }
+            return energy;
+        }
+        for color in &self.colors {
+            energy += color.par_iter().with_min_len(256).map_init(init, |st, &e| kernel(st, e)).sum::<f64>();
         }
         energy
     }

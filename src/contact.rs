@@ -82,6 +82,9 @@ pub struct ContactPair {
     /// (lambda = min(0, lambda_bar + eps Psi)): a damped Newton step at the kink that ends the
     /// cycling and converges to the exact (non-adhesive) solution.
     pub max_flips: u32,
+    /// The largest |lambda| seen in the current load step (the scale of "near the kink" for
+    /// frozen points; it persists while every point is momentarily inactive).
+    pub lambda_scale: f64,
 }
 
 impl ContactPair {
@@ -102,6 +105,7 @@ impl ContactPair {
             hold_active_set: false,
             initialized: false,
             max_flips: 10,
+            lambda_scale: 0.0,
         }
     }
 
@@ -109,6 +113,7 @@ impl ContactPair {
     pub fn start_step(&mut self) {
         self.flips.fill(0);
         self.frozen.fill(false);
+        self.lambda_scale = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
     }
 
     /// Evaluate Psi, the multipliers and the active set at the full displacement vector `u` and
@@ -120,7 +125,8 @@ impl ContactPair {
         let mut changes = 0;
         let with_tangent = add_tangent.is_some();
         let first = !self.initialized;
-        let band = 1e-2 * self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
+        self.lambda_scale = self.state.iter().map(|s| s.lambda.abs()).fold(self.lambda_scale, f64::max);
+        let band = 1e-2 * self.lambda_scale;
         for (k, p) in self.points.iter().enumerate() {
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);

@@ -5,7 +5,7 @@
 
 use crate::error::{Result, StampError};
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par};
 use std::time::Instant;
@@ -19,6 +19,9 @@ pub struct SolverTimings {
     pub factorizations: usize,
     pub solves: usize,
 }
+
+/// Matrices with fewer rows are factorised on one thread.
+pub const PARALLEL_MIN_ROWS: usize = 20_000;
 
 /// Factorise a sparse square matrix and solve with it.
 pub trait LinearSolver: Send {
@@ -62,6 +65,12 @@ impl SparseLu {
         }
     }
 
+    /// The parallelism used for a matrix of n rows: sequential below [`PARALLEL_MIN_ROWS`], where
+    /// waking threads costs more than the factorisation.
+    fn effective_par(&self, n: usize) -> Par {
+        if n < PARALLEL_MIN_ROWS { Par::Seq } else { self.par }
+    }
+
     /// Use a given parallelism for the factorisation and solves.
     pub fn with_parallelism(par: Par) -> Self {
         SparseLu { par, ..Self::new() }
@@ -73,7 +82,7 @@ impl LinearSolver for SparseLu {
         let nnz = a.symbolic().row_idx().len();
         if self.symbolic.is_none() || self.pattern_nnz != nnz {
             let t = Instant::now();
-            let sym = factorize_symbolic_lu(a.symbolic(), Default::default())
+            let sym = factorize_symbolic_lu(a.symbolic(), LuSymbolicParams::default())
                 .map_err(|e| StampError::LinearSolver(format!("symbolic LU failed: {e:?}")))?;
             let scratch = sym.factorize_numeric_lu_scratch::<f64>(self.par, Default::default())
                 .or(sym.solve_in_place_scratch::<f64>(1, self.par));
@@ -83,10 +92,11 @@ impl LinearSolver for SparseLu {
             self.timings.symbolic += t.elapsed().as_secs_f64();
         }
         let t = Instant::now();
+        let par = self.effective_par(a.nrows());
         let sym = self.symbolic.as_ref().unwrap();
         let stack = MemStack::new(self.buffer.as_mut().unwrap());
         self.factored = false;
-        sym.factorize_numeric_lu(&mut self.numeric, a, self.par, stack, Default::default())
+        sym.factorize_numeric_lu(&mut self.numeric, a, par, stack, Default::default())
             .map_err(|e| StampError::LinearSolver(format!("numeric LU failed (singular matrix?): {e:?}")))?;
         self.factored = true;
         self.timings.factorization += t.elapsed().as_secs_f64();
@@ -103,8 +113,9 @@ impl LinearSolver for SparseLu {
         let lu = LuRef::new_unchecked(sym, &self.numeric);
         let n = b.len();
         let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
+        let par = self.effective_par(n);
         let stack = MemStack::new(self.buffer.as_mut().unwrap());
-        lu.solve_in_place_with_conj(Conj::No, rhs, self.par, stack);
+        lu.solve_in_place_with_conj(Conj::No, rhs, par, stack);
         self.timings.solve += t.elapsed().as_secs_f64();
         self.timings.solves += 1;
         if b.iter().any(|x| !x.is_finite()) {

@@ -171,6 +171,20 @@ impl SparsePattern {
         self.symbolic.col_ptr()[col_eq] + self.block_start[e * npe * npe + b * npe + a] as usize + self.rank[row_dof] as usize
     }
 
+    /// Slot of the first entry of the block (local node `a`, local node `b`) of element `e` in the
+    /// column with equation `col_eq`: the row of dof d of node a sits at this + [`rank`](Self::rank)(d).
+    #[inline]
+    pub fn block_slot(&self, e: usize, a: usize, b: usize, col_eq: usize) -> usize {
+        let npe = self.nodes_per_element;
+        self.symbolic.col_ptr()[col_eq] + self.block_start[e * npe * npe + b * npe + a] as usize
+    }
+
+    /// Rank of a free dof among the free dofs of its node (its row offset inside a node block).
+    #[inline]
+    pub fn rank(&self, dof: usize) -> u32 {
+        self.rank[dof] as u32
+    }
+
     /// Slot of the diagonal-block entry (row dof, column dof) at one node, for contributions that
     /// couple only the dofs of a single node (nodal contact). `None` when either dof is prescribed.
     pub fn nodal_slot(&self, dofs: &DofMap, row_dof: usize, col_dof: usize) -> Option<usize> {

@@ -33,6 +33,18 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Time the solve of the simply supported plate under a sphere (quarter model) on n x n meshes.
+    Bench {
+        /// Mesh sizes n (n x n elements on the quarter), comma separated.
+        #[arg(long, value_delimiter = ',', default_values_t = stamp_cli::bench::DEFAULT_SIZES)]
+        sizes: Vec<usize>,
+        /// Print the results as JSON: {"runs": [...]}.
+        #[arg(long)]
+        json: bool,
+        /// Run one size in this process and print its JSON (used by `stamp bench` for each size).
+        #[arg(long, hide = true)]
+        one: Option<usize>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -41,6 +53,8 @@ fn main() -> ExitCode {
         None => stamp_cli::report::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::report::paper_command(json, plot.as_deref()),
         Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
+        Some(Command::Bench { one: Some(n), .. }) => stamp_cli::bench::one_command(n),
+        Some(Command::Bench { sizes, json, one: None }) => stamp_cli::bench::bench_command(&sizes, json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

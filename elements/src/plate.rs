@@ -12,6 +12,8 @@ use crate::strain::{Affine, Sample, NDOF, NPAIR};
 use stamp::element::{Element, LocalSystem};
 use stamp::mesh::QuadMesh;
 use stamp::Result;
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
 
 /// Dofs per node: v-_1, v-_2, v-_3, v+_1, v+_2, v+_3.
 pub const DOFS_PER_NODE: usize = 6;
@@ -58,8 +60,10 @@ const NQUAD: usize = 36; // samples with a Hessian (nonlinear kinematics)
 /// Per-thread scratch memory of the plate element.
 pub struct PlateWorkspace {
     samples: Box<[Sample; NSAMPLE]>,
-    b: [[f64; NDOF]; NSTRAIN],
-    db: [[f64; NDOF]; NSTRAIN],
+    /// Rows dE_c/dV of the assumed strains, Gauss point after Gauss point (4 x 11 rows).
+    b: [[f64; NDOF]; 4 * NSTRAIN],
+    /// The same rows multiplied by w D (the Gauss weight times det J times the stiffness).
+    db: [[f64; NDOF]; 4 * NSTRAIN],
     mu: [f64; NSAMPLE],
 }
 
@@ -235,8 +239,8 @@ impl Element for PlateElements {
     fn new_workspace(&self) -> PlateWorkspace {
         PlateWorkspace {
             samples: Box::new([Sample::default(); NSAMPLE]),
-            b: [[0.0; NDOF]; NSTRAIN],
-            db: [[0.0; NDOF]; NSTRAIN],
+            b: [[0.0; NDOF]; 4 * NSTRAIN],
+            db: [[0.0; NDOF]; 4 * NSTRAIN],
             mu: [0.0; NSAMPLE],
         }
     }
@@ -249,17 +253,18 @@ impl Element for PlateElements {
         for g in 0..4 {
             let w = geo.wdet[g];
             let mut strain = [0.0; NSTRAIN];
+            let rows = &mut ws.b[g * NSTRAIN..(g + 1) * NSTRAIN];
             let mut terms = [([(0usize, 0.0); 8], 0usize); NSTRAIN];
             for c in 0..NSTRAIN {
                 terms[c] = Self::terms(geo, g, c);
                 let (t, n) = &terms[c];
-                let row = &mut ws.b[c];
+                let row = &mut rows[c];
                 *row = [0.0; NDOF];
                 for &(s, coef) in &t[..*n] {
                     let smp = &ws.samples[s];
                     strain[c] += coef * smp.val;
-                    for i in 0..NDOF {
-                        row[i] += coef * smp.grad[i];
+                    for (r, &gr) in row.iter_mut().zip(&smp.grad) {
+                        *r += coef * gr;
                     }
                 }
             }
@@ -270,38 +275,25 @@ impl Element for PlateElements {
             out.energy += 0.5 * w * (0..NSTRAIN).map(|c| strain[c] * stress[c]).sum::<f64>();
             for c in 0..NSTRAIN {
                 let f = w * stress[c];
-                for i in 0..NDOF {
-                    out.residual[i] += f * ws.b[c][i];
+                for (r, &b) in out.residual.iter_mut().zip(&rows[c]) {
+                    *r += f * b;
                 }
             }
             if !with_tangent {
                 continue;
             }
-            // D B
+            // w D B at this Gauss point
             for r in 0..NSTRAIN {
                 let mut row = [0.0; NDOF];
                 for c in 0..NSTRAIN {
-                    let drc = d[r][c];
+                    let drc = w * d[r][c];
                     if drc != 0.0 {
-                        for i in 0..NDOF {
-                            row[i] += drc * ws.b[c][i];
+                        for (x, &b) in row.iter_mut().zip(&rows[c]) {
+                            *x += drc * b;
                         }
                     }
                 }
-                ws.db[r] = row;
-            }
-            // B^T D B
-            for c in 0..NSTRAIN {
-                for i in 0..NDOF {
-                    let bi = w * ws.b[c][i];
-                    if bi == 0.0 {
-                        continue;
-                    }
-                    let krow = &mut out.tangent[i * NDOF..(i + 1) * NDOF];
-                    for j in 0..NDOF {
-                        krow[j] += bi * ws.db[c][j];
-                    }
-                }
+                ws.db[g * NSTRAIN + r] = row;
             }
             // weights of the sample Hessians in the geometric stiffness
             for c in 0..NSTRAIN {
@@ -311,21 +303,34 @@ impl Element for PlateElements {
                 }
             }
         }
-        if with_tangent && self.kinematics == Kinematics::Nonlinear {
-            for s in 0..NQUAD {
-                let m = ws.mu[s];
-                if m == 0.0 {
+        if !with_tangent {
+            return;
+        }
+        // material stiffness: sum over the Gauss points of B^T (w D B), one 24 x 44 x 24 product
+        let b = MatRef::from_row_major_slice(ws.b.as_flattened(), 4 * NSTRAIN, NDOF);
+        let db = MatRef::from_row_major_slice(ws.db.as_flattened(), 4 * NSTRAIN, NDOF);
+        let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..NDOF * NDOF], NDOF, NDOF);
+        matmul(k, Accum::Add, b.transpose(), db, 1.0, Par::Seq);
+        // geometric stiffness: sum_s mu_s Hess_s (x) I3, Hess_s = scale (a b^T + b a^T)
+        if self.kinematics == Kinematics::Nonlinear {
+            let mut h = [[0.0; NPAIR]; NPAIR];
+            for (smp, &m) in ws.samples[..NQUAD].iter().zip(&ws.mu[..NQUAD]) {
+                let f = m * smp.scale;
+                if f == 0.0 {
                     continue;
                 }
-                let hs = &ws.samples[s].hess;
-                for k in 0..NPAIR {
+                for kk in 0..NPAIR {
+                    let (fa, fb) = (f * smp.a[kk], f * smp.b[kk]);
                     for l in 0..NPAIR {
-                        let val = m * hs[k][l];
-                        if val != 0.0 {
-                            for i in 0..3 {
-                                out.tangent[(3 * k + i) * NDOF + 3 * l + i] += val;
-                            }
-                        }
+                        h[kk][l] += fa * smp.b[l] + fb * smp.a[l];
+                    }
+                }
+            }
+            for kk in 0..NPAIR {
+                for l in 0..NPAIR {
+                    let val = h[kk][l];
+                    for i in 0..3 {
+                        out.tangent[(3 * kk + i) * NDOF + 3 * l + i] += val;
                     }
                 }
             }

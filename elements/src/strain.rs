@@ -38,17 +38,21 @@ impl Affine {
     }
 }
 
-/// One strain: value, gradient with respect to the 24 element dofs, and Hessian coefficients.
+/// One strain: value, gradient with respect to the 24 element dofs, and its (constant) Hessian
+/// in factored form: s (a b^T + b a^T) over the (node, face) pairs, times the 3 x 3 identity.
 #[derive(Debug, Clone, Copy)]
 pub struct Sample {
     pub val: f64,
     pub grad: [f64; NDOF],
-    pub hess: [[f64; NPAIR]; NPAIR],
+    /// Scale s of the Hessian (0 for a linear strain).
+    pub scale: f64,
+    pub a: [f64; NPAIR],
+    pub b: [f64; NPAIR],
 }
 
 impl Default for Sample {
     fn default() -> Self {
-        Sample { val: 0.0, grad: [0.0; NDOF], hess: [[0.0; NPAIR]; NPAIR] }
+        Sample { val: 0.0, grad: [0.0; NDOF], scale: 0.0, a: [0.0; NPAIR], b: [0.0; NPAIR] }
     }
 }
 
@@ -65,14 +69,19 @@ impl Sample {
             for i in 0..3 {
                 self.grad[3 * k + i] = s * (a.c[k] * b.g[i] + b.c[k] * a.g[i]);
             }
-            for l in 0..NPAIR {
-                self.hess[k][l] = s * (a.c[k] * b.c[l] + b.c[k] * a.c[l]);
-            }
         }
+        self.scale = s;
+        self.a = a.c;
+        self.b = b.c;
+    }
+
+    /// Hessian coefficient (k, l) over the (node, face) pairs.
+    pub fn hessian(&self, k: usize, l: usize) -> f64 {
+        self.scale * (self.a[k] * self.b[l] + self.b[k] * self.a[l])
     }
 
     /// The part linear in the displacements, s (g0A . dB + g0B . dA) with d = g - g0: the strain of
-    /// the geometrically linear theory (eta = 0). The Hessian is zero and is not written.
+    /// the geometrically linear theory (eta = 0). Its Hessian is zero.
     pub fn linear(&mut self, s: f64, a: &Affine, b: &Affine) {
         let da = [a.g[0] - a.g0[0], a.g[1] - a.g0[1], a.g[2] - a.g0[2]];
         let db = [b.g[0] - b.g0[0], b.g[1] - b.g0[1], b.g[2] - b.g0[2]];
@@ -82,5 +91,6 @@ impl Sample {
                 self.grad[3 * k + i] = s * (a.c[k] * b.g0[i] + b.c[k] * a.g0[i]);
             }
         }
+        self.scale = 0.0;
     }
 }

@@ -1,0 +1,226 @@
+//! `stamp bench`: the simply supported square plate pressed by a rigid sphere at its centre (the
+//! quarter model), solved on n x n structured meshes with the same loads at every size, timing
+//! each phase of the solve.
+//!
+//! Every size runs in a child process of its own (`stamp bench --one N`), so that its peak
+//! resident memory is its own and no size warms the caches of the next.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
+use stamp::dofs::DofMap;
+use stamp::io::{write_vtu, Field};
+use stamp::linear_solver::{LinearSolver, SparseLu};
+use stamp::mesh::QuadMesh;
+use stamp::model::Model;
+use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
+use stamp::{Result, StampError};
+use stamp_contact::Sphere;
+use stamp_elements::{Face, Isotropic, Kinematics, PlateElements, Section};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The benchmark problem: a square plate of side `SIDE` (the quarter [0, SIDE/2]^2 is meshed),
+/// thickness `THICKNESS`, steel, simply supported on its edges, pressed by a sphere of radius
+/// `RADIUS` moved down by `PUNCH_TRAVEL` (twice the thickness: bending and membrane action).
+pub const SIDE: f64 = 100.0;
+pub const THICKNESS: f64 = 1.0;
+pub const YOUNG: f64 = 2.1e5;
+pub const POISSON: f64 = 0.3;
+pub const RADIUS: f64 = 50.0;
+pub const PUNCH_TRAVEL: f64 = 2.0;
+/// The default sizes of `stamp bench`.
+pub const DEFAULT_SIZES: [usize; 5] = [25, 50, 100, 200, 400];
+
+/// Seconds spent in each phase.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+pub struct Seconds {
+    pub assembly: f64,
+    pub contact: f64,
+    pub symbolic: f64,
+    pub factorization: f64,
+    pub solve: f64,
+    pub output: f64,
+    pub total: f64,
+}
+
+/// One size of the benchmark.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BenchRun {
+    pub n: usize,
+    pub unknowns: usize,
+    pub steps: usize,
+    pub newton_iterations: usize,
+    pub seconds: Seconds,
+    pub peak_rss_bytes: u64,
+    pub assemblies: usize,
+    pub factorizations: usize,
+    pub threads: usize,
+    /// Centre deflection of the mid-surface and the total contact force on the whole plate: the
+    /// same problem at every size, so these converge with n.
+    pub centre_deflection: f64,
+    pub reaction: f64,
+}
+
+/// Build the quarter model on an n x n mesh.
+fn build(n: usize) -> Result<Model<PlateElements>> {
+    let half = 0.5 * SIDE;
+    let mesh = QuadMesh::rectangle(0.0, half, 0.0, half, n, n)?;
+    let section = Section::homogeneous(THICKNESS, Isotropic::new(YOUNG, POISSON)?)?;
+    let plate = PlateElements::new(&mesh, section, Kinematics::Nonlinear)?;
+    let mut dofs = DofMap::new(mesh.num_nodes(), 6)?;
+    dofs.fix(mesh.group_nodes("left")?, &[0, 3])?; // symmetry x1 = 0: v1- = v1+ = 0
+    dofs.fix(mesh.group_nodes("bottom")?, &[1, 4])?; // symmetry x2 = 0
+    dofs.fix(mesh.group_nodes("right")?, &[2, 5])?; // simply supported: v3- = v3+ = 0
+    dofs.fix(mesh.group_nodes("top")?, &[2, 5])?;
+    let mut model = Model::new(plate, dofs)?;
+    let z = 0.5 * THICKNESS;
+    let sphere = Arc::new(Sphere::new(Vector3::new(0.0, 0.0, z + RADIUS), RADIUS)?);
+    let areas = mesh.nodal_areas();
+    let points = (0..mesh.num_nodes())
+        .map(|k| {
+            let x = mesh.coords[k];
+            ContactPoint { node: k, x_ref: [x[0], x[1], z], dofs: [0, 1, 2].map(|c| Face::Top.dof(k, c)), weight: areas[k] }
+        })
+        .collect();
+    let le = half / n as f64;
+    let grad = 2.0 * RADIUS;
+    let eps_reg = 100.0 * YOUNG * THICKNESS / (le * le * grad * grad);
+    let mut pair = ContactPair::new("sphere", sphere, points, eps_reg, ContactKinematics::Exact);
+    pair.motion = [0.0, 0.0, -PUNCH_TRAVEL];
+    model.contacts.push(pair);
+    Ok(model)
+}
+
+/// Peak resident memory of this process (Linux: VmHWM of /proc/self/status), 0 where unknown.
+pub fn peak_rss_bytes() -> u64 {
+    let Ok(status) = std::fs::read_to_string("/proc/self/status") else { return 0 };
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        .map(|kb| kb * 1024)
+        .unwrap_or(0)
+}
+
+/// Solve one size in this process and time it. The deformed plate of the last step is written as
+/// a .vtu file into a temporary folder (timed as output) and removed.
+pub fn run_one(n: usize) -> Result<BenchRun> {
+    if n == 0 {
+        return Err(StampError::Problem("bench sizes must be positive".into()));
+    }
+    let start = Instant::now();
+    let mut model = build(n)?;
+    let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, ..NewtonSettings::default() };
+    let mut newton = NewtonRaphson::new(SparseLu::new(), settings);
+    let mut u = vec![0.0; model.num_dofs()];
+    let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
+
+    let t_out = Instant::now();
+    let dir = std::env::temp_dir().join(format!("stamp-bench-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| StampError::io(&dir, e))?;
+    let mesh = QuadMesh::rectangle(0.0, 0.5 * SIDE, 0.0, 0.5 * SIDE, n, n)?;
+    let nn = mesh.num_nodes();
+    let mid: Vec<f64> = (0..nn).flat_map(|k| (0..3).map(move |c| (k, c))).map(|(k, c)| 0.5 * (u[6 * k + c] + u[6 * k + 3 + c])).collect();
+    let pressure = model.contacts[0].pressures();
+    let written = write_vtu(&dir.join("bench.vtu"), &mesh, &[Field::new("displacement", 3, mid), Field::scalar("contact_pressure", pressure)], &[]);
+    let _ = std::fs::remove_dir_all(&dir);
+    written?;
+    let output = t_out.elapsed().as_secs_f64();
+
+    let mt = model.timings;
+    let st = newton.linear.timings();
+    let reaction = -4.0 * model.contacts[0].reaction()[2];
+    Ok(BenchRun {
+        n,
+        unknowns: model.num_equations(),
+        steps: summary.steps,
+        newton_iterations: summary.newton_iterations,
+        seconds: Seconds {
+            assembly: mt.assembly,
+            contact: mt.contact,
+            symbolic: st.symbolic,
+            factorization: st.factorization,
+            solve: st.solve,
+            output,
+            total: start.elapsed().as_secs_f64(),
+        },
+        peak_rss_bytes: peak_rss_bytes(),
+        assemblies: mt.assemblies,
+        factorizations: st.factorizations,
+        threads: rayon::current_num_threads(),
+        centre_deflection: 0.5 * (u[2] + u[5]),
+        reaction,
+    })
+}
+
+/// Run every size in a child process (`<this program> bench --one n`) and collect the results.
+pub fn run_sizes(sizes: &[usize], mut on_run: impl FnMut(&BenchRun)) -> Result<Vec<BenchRun>> {
+    let exe = std::env::current_exe().map_err(|e| StampError::io("the stamp program itself", e))?;
+    let mut runs = Vec::new();
+    for &n in sizes {
+        let out = std::process::Command::new(&exe)
+            .args(["bench", "--one", &n.to_string()])
+            .output()
+            .map_err(|e| StampError::io(&exe, e))?;
+        if !out.status.success() {
+            return Err(StampError::Problem(format!("bench size n = {n} failed: {}", String::from_utf8_lossy(&out.stderr).trim())));
+        }
+        let run: BenchRun = serde_json::from_slice(&out.stdout).map_err(|e| StampError::Problem(format!("bench size n = {n}: unreadable result: {e}")))?;
+        on_run(&run);
+        runs.push(run);
+    }
+    Ok(runs)
+}
+
+/// The table header of the text report.
+pub fn header() -> String {
+    format!(
+        "stamp bench: simply supported square plate (side {SIDE}, h = {THICKNESS}, quarter model) under a sphere (R = {RADIUS}, travel {PUNCH_TRAVEL})\n\
+         {:>5} {:>9} {:>5} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
+        "n", "unknowns", "steps", "newton", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
+    )
+}
+
+/// One row of the text report (seconds; memory in MiB).
+pub fn row(r: &BenchRun) -> String {
+    let s = &r.seconds;
+    format!(
+        "{:>5} {:>9} {:>5} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
+        r.n,
+        r.unknowns,
+        r.steps,
+        r.newton_iterations,
+        s.assembly,
+        s.contact,
+        s.symbolic,
+        s.factorization,
+        s.solve,
+        s.output,
+        s.total,
+        r.peak_rss_bytes as f64 / (1024.0 * 1024.0),
+        r.centre_deflection,
+        r.reaction
+    )
+}
+
+/// `stamp bench`: all sizes, as a table or as JSON.
+pub fn bench_command(sizes: &[usize], json: bool) -> Result<()> {
+    if json {
+        let runs = run_sizes(sizes, |_| {})?;
+        let text = serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).map_err(|e| StampError::Problem(e.to_string()))?;
+        println!("{text}");
+    } else {
+        println!("{}", header());
+        run_sizes(sizes, |r| println!("{}", row(r)))?;
+        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve", rayon::current_num_threads());
+    }
+    Ok(())
+}
+
+/// `stamp bench --one n`: one size, as one JSON object on stdout.
+pub fn one_command(n: usize) -> Result<()> {
+    let run = run_one(n)?;
+    println!("{}", serde_json::to_string(&run).map_err(|e| StampError::Problem(e.to_string()))?);
+    Ok(())
+}
