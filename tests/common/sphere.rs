@@ -216,12 +216,32 @@ impl SphereProblem {
                 let x = mesh.coords[p.node];
                 let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
                 radius = radius.max(r);
-                let fz = -p.weight * s.lambda * s.grad[2];
+                let fz = (p.weight * s.lambda * s.grad[2]).abs();
                 fr += fz * r;
                 f += fz;
             }
         }
+        // the edge of contact on the symmetry axis x2 = 0, x1 >= 0: the zero of the gap Psi / |grad Psi|
+        // (a signed distance), interpolated linearly between the outermost node in contact and the
+        // next one out
+        let mut axis: Vec<(f64, f64)> = pair
+            .points
+            .iter()
+            .zip(&pair.state)
+            .filter(|(p, _)| mesh.coords[p.node][1] == 0.0 && mesh.coords[p.node][0] >= 0.0)
+            .map(|(p, s)| (mesh.coords[p.node][0], s.psi / nalgebra::Vector3::from(s.grad).norm()))
+            .collect();
+        axis.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut edge = 0.0;
+        for k in (1..axis.len()).rev() {
+            let ((x0, g0), (x1, g1)) = (axis[k - 1], axis[k]);
+            if g0 <= 0.0 && g1 > 0.0 {
+                edge = x0 + (x1 - x0) * (-g0) / (g1 - g0);
+                break;
+            }
+        }
         SphereResult {
+            edge,
             w: -0.5 * (u[Face::Bottom.dof(c, 2)] + u[Face::Top.dof(c, 2)]),
             w_top: -u[Face::Top.dof(c, 2)],
             reaction: -scale * pair.reaction()[2],
@@ -249,11 +269,14 @@ impl SphereProblem {
 }
 
 /// Centre deflection (mid-surface, positive down), the punch's force on the whole plate (positive
-/// down), the contact radius (reference distance of the outermost node carrying load), the
+/// down), the contact radius on the x1 axis (interpolated zero of the gap) and that of the
+/// outermost node carrying load (reference distance from the centre), the
 /// force-weighted mean radius of the contact force, the number of loaded nodes.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SphereResult {
     pub w: f64,
+    /// Contact radius: where the gap changes sign on the axis x2 = 0 (interpolated).
+    pub edge: f64,
     pub w_top: f64,
     pub reaction: f64,
     pub radius: f64,
