@@ -16,7 +16,7 @@
 //! the hard support, whose thin limit is Kirchhoff's. Both are checked. The soft support carries a
 //! boundary layer of width ~h whose effect on the deflection is O(h/a); it grows as the mesh resolves
 //! the layer (measured: +0.32 % at n = 16, +0.50 % at 32, +0.67 % at 64 quarter elements, against
-//! +0.13 %, +0.17 %, +0.21 % for the hard support). What remains for the hard support is the
+//! +0.14 %, +0.18 %, +0.22 % for the hard support). What remains for the hard support is the
 //! shear deflection under a concentrated load, P / (2 pi G h) ln(a / l_e) ~ 3e-4 ln(a / l_e) of the
 //! Kirchhoff value for h/a = 0.01: it grows like ln(1/l_e) because the Mindlin point-load solution is
 //! singular at the load. To show the boundary conditions themselves are right the uniform-load
