@@ -83,7 +83,7 @@ pub struct ContactPair {
     /// cycling and converges to the exact (non-adhesive) solution.
     pub max_flips: u32,
     /// The largest |lambda| seen in the current load step (the scale of "near the kink" for
-    /// frozen points; it persists while every point is momentarily inactive).
+    /// frozen points while every point is momentarily inactive).
     pub lambda_scale: f64,
 }
 
@@ -125,8 +125,11 @@ impl ContactPair {
         let mut changes = 0;
         let with_tangent = add_tangent.is_some();
         let first = !self.initialized;
-        self.lambda_scale = self.state.iter().map(|s| s.lambda.abs()).fold(self.lambda_scale, f64::max);
-        let band = 1e-2 * self.lambda_scale;
+        // "near the kink" is 1 % of the largest multiplier now, or of the largest in this step
+        // when every point is momentarily inactive (a lone point swinging in and out)
+        let current = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
+        self.lambda_scale = self.lambda_scale.max(current);
+        let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
         for (k, p) in self.points.iter().enumerate() {
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);

@@ -83,7 +83,7 @@ impl<E: Element> Model<E> {
     }
 
     /// Internal + contact forces over all dofs at the last evaluation; at prescribed dofs these are
-    /// the support reactions (with the sign of a force the body exerts on the support).
+    /// the support reactions (plus any load applied there): the force the support exerts on the body.
     pub fn nodal_forces(&self) -> &[f64] {
         &self.force
     }

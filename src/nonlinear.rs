@@ -172,7 +172,10 @@ impl<L: LinearSolver> NewtonRaphson<L> {
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history,
     /// or the reason for failure.
-    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
+    /// `peak_scale` is the largest force scale of the converged states of this path so far: the
+    /// round-off floor of the residual (criterion `floor_tol`) is measured against it too, because
+    /// the round-off of the internal forces does not vanish with the load (unloading to zero).
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_scale: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
         let s = &self.settings;
         let mut history = Vec::new();
         let mut du = vec![0.0; p.num_equations()];
@@ -202,8 +205,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             let u_max = u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let fixed = last_correction <= s.disp_tol * u_max && ev.residual_norm <= s.loose_tol * ev.force_scale;
             let energy = it > 1 && stalled && last_energy <= s.energy_tol * first_energy && ev.residual_norm <= 1e2 * s.loose_tol * ev.force_scale;
-            if ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || fixed || energy {
+            if ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale.max(*peak_scale)) || fixed || energy {
                 if ev.active_changes == 0 {
+                    *peak_scale = peak_scale.max(ev.force_scale);
                     return Ok(history);
                 }
                 if p.update_active_set() > 0 && it < s.max_iterations {
@@ -275,6 +279,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         let mut trial = u.to_vec();
         // the converged state before the last one, for the predictor
         let mut previous: Option<(Vec<f64>, f64)> = None;
+        let mut peak_scale = 0.0f64;
         let first_span = targets.first().map(|&x| (x - t0).abs()).unwrap_or(1.0);
         let mut dt = (self.settings.initial_increment * first_span).min(self.settings.max_increment);
         p.checkpoint();
@@ -300,7 +305,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 p.start_step();
                 let mut restarts = 0;
                 let result = loop {
-                    match self.iterate(p, &mut trial, step_t) {
+                    match self.iterate(p, &mut trial, step_t, &mut peak_scale) {
                         Ok(h) => {
                             if restarts < self.settings.max_restarts && p.end_step(&trial, step_t) {
                                 restarts += 1;

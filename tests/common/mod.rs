@@ -92,3 +92,5 @@ pub fn cantilever_strip(l: f64, h: f64, elements: usize, force: f64, kin: Kinema
 pub fn bending_stiffness(h: f64) -> f64 {
     2.0e5 * h * h * h / (12.0 * (1.0 - 0.09))
 }
+
+pub mod sphere;
