@@ -10,12 +10,14 @@
 //! element (eq. 4.12 with its 3^-(r1+r2) weights); on a general quadrilateral it still reproduces any
 //! constant strain, so the membrane patch test is passed.
 //!
-//! The transverse shear E13 on {1, xi2} and E23 on {1, xi1} is projected in covariant components
-//! along the lines xi1 = 0 and xi2 = 0 (equal to the paper's projection on rectangles), plus a
-//! correction that replaces the linear part of the strain by its interpolation between the edge
-//! midpoints (the tying points of Bathe and Dvorkin's MITC4). The correction vanishes on
-//! parallelograms and for rigid-body motions, and makes the bending patch test exact on distorted
-//! meshes; it is what keeps the element free of shear locking.
+//! The transverse shear E13 on {1, xi2} and E23 on {1, xi1}: on a parallelogram (every rectangle)
+//! it is projected in covariant components along the lines xi1 = 0 and xi2 = 0, exactly the
+//! paper's projection. On any other quadrilateral the line samples would fail the bending patch
+//! test, so the covariant shear is instead interpolated between the edge midpoints (the tying
+//! points of Bathe and Dvorkin's MITC4), with the full Green-Lagrange strain there: the two agree
+//! in the linear part on parallelograms, the tying form passes the bending patch test on distorted
+//! meshes and, being built from full strains only, stays objective (a rigid rotation superposed on
+//! any deformed state leaves it unchanged). This is what keeps the element free of shear locking.
 
 use stamp::mesh::bilinear;
 use stamp::{Result, StampError};
@@ -65,6 +67,9 @@ pub struct ElementGeometry {
     pub proj: [[[f64; 4]; 4]; 3],
     /// Area of the element.
     pub area: f64,
+    /// Opposite sides parallel (x1 - x0 = x2 - x3 to round-off): the paper's line sampling of the
+    /// transverse shear is used; otherwise its tying interpolation (see the module doc).
+    pub parallelogram: bool,
 }
 
 fn jacobian(x: &[[f64; 2]; 4], dn: &[[f64; 2]; 4]) -> [[f64; 2]; 2] {
@@ -127,6 +132,7 @@ impl ElementGeometry {
             }
         }
         geo.area = geo.wdet.iter().sum();
+        geo.parallelogram = (0..2).all(|i| ((x[1][i] - x[0][i]) - (x[2][i] - x[3][i])).abs() <= 1e-12 * size);
         let shear_point = |p: &[f64; 2], dir: usize| {
             let (n, dn) = bilinear(p[0], p[1]);
             let mut sp = ShearPoint { n, ..Default::default() };

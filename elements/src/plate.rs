@@ -51,11 +51,10 @@ pub enum Kinematics {
 // Sample numbering (see strain.rs): displacement-based strains evaluated per element.
 const MEM: usize = 0; // + g*6 + face*3 + {0: E11, 1: E22, 2: 2E12}
 const E33: usize = 24; // + g
-const LINE: usize = 28; // + pt*2 + face: full covariant shear on the lines
-const LINE_LIN: usize = 36; // + pt*2 + face: its linear part
-const TYING_LIN: usize = 44; // + pt*2 + face: linear covariant shear at the edge midpoints
-const NSAMPLE: usize = 52;
-const NQUAD: usize = 36; // samples with a Hessian (nonlinear kinematics)
+const LINE: usize = 28; // + pt*2 + face: full covariant shear on the lines (parallelograms)
+const TYING: usize = 36; // + pt*2 + face: full covariant shear at the edge midpoints (other quads)
+const NSAMPLE: usize = 44;
+const NQUAD: usize = 44; // samples with a Hessian (nonlinear kinematics)
 
 /// Per-thread scratch memory of the plate element.
 pub struct PlateWorkspace {
@@ -135,10 +134,12 @@ impl PlateElements {
                 let comps = [(if x2 < 0.0 { 0 } else { 1 }, x2, 0usize), (if x1 < 0.0 { 2 } else { 3 }, x1, 2usize)];
                 for (a, &(pt, xi, tp)) in comps.iter().enumerate() {
                     let w = geo.jit[g][row][a];
-                    push(LINE + pt * 2 + face, w);
-                    push(LINE_LIN + pt * 2 + face, -w);
-                    push(TYING_LIN + tp * 2 + face, w * 0.5 * (1.0 - xi));
-                    push(TYING_LIN + (tp + 1) * 2 + face, w * 0.5 * (1.0 + xi));
+                    if geo.parallelogram {
+                        push(LINE + pt * 2 + face, w);
+                    } else {
+                        push(TYING + tp * 2 + face, w * 0.5 * (1.0 - xi));
+                        push(TYING + (tp + 1) * 2 + face, w * 0.5 * (1.0 + xi));
+                    }
                 }
             }
             _ => push(E33 + g, 1.0),
@@ -188,16 +189,13 @@ impl PlateElements {
             }
         }
         for pt in 0..4 {
-            let lp = &geo.line[pt];
-            let tp = &geo.tying[pt];
-            let g3l = fibre(&lp.n);
-            let g3t = fibre(&tp.n);
+            // only the shear samples this element's interpolation uses (see terms())
+            let sp = if geo.parallelogram { &geo.line[pt] } else { &geo.tying[pt] };
+            let base = if geo.parallelogram { LINE } else { TYING };
+            let g3 = fibre(&sp.n);
             for face in 0..2 {
-                let gl = tangent(lp.base, lp.dn, face);
-                put(LINE + pt * 2 + face, 1.0, &gl, &g3l, true);
-                put(LINE_LIN + pt * 2 + face, 1.0, &gl, &g3l, false);
-                let gt = tangent(tp.base, tp.dn, face);
-                put(TYING_LIN + pt * 2 + face, 1.0, &gt, &g3t, false);
+                let gt = tangent(sp.base, sp.dn, face);
+                put(base + pt * 2 + face, 1.0, &gt, &g3, true);
             }
         }
     }
