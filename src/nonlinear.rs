@@ -175,7 +175,10 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     /// `peak_scale` is the largest force scale of the converged states of this path so far: the
     /// round-off floor of the residual (criterion `floor_tol`) is measured against it too, because
     /// the round-off of the internal forces does not vanish with the load (unloading to zero).
-    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_scale: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
+    /// `peak_energy` is likewise the largest first-correction energy of the path's converged steps:
+    /// the energy criterion compares with it too, because a step that starts from a good predictor
+    /// has a first correction already at round-off.
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_scale: &mut f64, peak_energy: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
         let s = &self.settings;
         let mut history = Vec::new();
         let mut du = vec![0.0; p.num_equations()];
@@ -204,10 +207,16 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             let stalled = it > 0 && ev.residual_norm > 0.5 * history[history.len() - 2];
             let u_max = u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let fixed = last_correction <= s.disp_tol * u_max && ev.residual_norm <= s.loose_tol * ev.force_scale;
-            let energy = it > 1 && stalled && last_energy <= s.energy_tol * first_energy && ev.residual_norm <= 1e2 * s.loose_tol * ev.force_scale;
+            // a step whose first correction is already at round-off (a predictor that hit the
+            // solution) measures its energies against the path's
+            let reference = if first_energy < 1e-6 * *peak_energy { *peak_energy } else { first_energy };
+            let energy = it > 1 && stalled && last_energy <= s.energy_tol * reference && ev.residual_norm <= 1e2 * s.loose_tol * ev.force_scale;
             if ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale.max(*peak_scale)) || fixed || energy {
                 if ev.active_changes == 0 {
                     *peak_scale = peak_scale.max(ev.force_scale);
+                    if first_energy.is_finite() {
+                        *peak_energy = peak_energy.max(first_energy);
+                    }
                     return Ok(history);
                 }
                 if p.update_active_set() > 0 && it < s.max_iterations {
@@ -280,6 +289,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         // the converged state before the last one, for the predictor
         let mut previous: Option<(Vec<f64>, f64)> = None;
         let mut peak_scale = 0.0f64;
+        let mut peak_energy = 0.0f64;
         let first_span = targets.first().map(|&x| (x - t0).abs()).unwrap_or(1.0);
         let mut dt = (self.settings.initial_increment * first_span).min(self.settings.max_increment);
         p.checkpoint();
@@ -305,7 +315,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 p.start_step();
                 let mut restarts = 0;
                 let result = loop {
-                    match self.iterate(p, &mut trial, step_t, &mut peak_scale) {
+                    match self.iterate(p, &mut trial, step_t, &mut peak_scale, &mut peak_energy) {
                         Ok(h) => {
                             if restarts < self.settings.max_restarts && p.end_step(&trial, step_t) {
                                 restarts += 1;
