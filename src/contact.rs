@@ -12,6 +12,18 @@
 //!
 //! The contact force on the body is -lambda grad Psi per unit area (eq. 3.13), the contact pressure
 //! q_n = -lambda |grad Psi| >= 0 (eq. 3.14 with compression counted positive).
+//!
+//! A punch is moved either by a prescribed displacement (`motion` times the load factor) or by a
+//! prescribed force ([`ForceDrive`]): then its rigid displacement s along a fixed direction n is one
+//! more unknown, with the punch's equilibrium as its equation,
+//! R_s = sum_k w_k lambda_k dPsi_k/ds - t F = -n . sum_k w_k lambda_k grad Psi_k - t F = 0
+//! (dPsi/ds = -grad Psi . n since the punch sits at x - d, d = t motion + s n). This is the
+//! derivative of the penalty energy sum w eps Psi^2 / 2 minus the work t F s, so the bordered
+//! tangent stays symmetric wherever the plate's is. The model appends these unknowns after the
+//! nodal dofs (see [`crate::model::Model`]).
+//!
+//! The default eps_reg is [`automatic_eps_reg`]: a contact spring per node that is a fixed multiple
+//! of the plate's membrane stiffness around it.
 
 use crate::surface::ContactSurface;
 use nalgebra::{Matrix3, Vector3};
@@ -27,6 +39,46 @@ pub enum ContactKinematics {
     /// undeformed body and lambda is the pressure itself (eq. 3.9).
     Shallow { direction: [f64; 3] },
 }
+
+/// A punch pressed by a prescribed force instead of moved by a prescribed displacement: the force
+/// `force * t` (t the load factor) pushes the punch along the unit `direction`, and its rigid
+/// displacement s along `direction` is an unknown. `dof` is the index of s in the full unknown
+/// vector; [`crate::model::Model`] assigns it (after the nodal dofs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForceDrive {
+    pub direction: [f64; 3],
+    pub force: f64,
+    pub dof: usize,
+}
+
+impl ForceDrive {
+    /// A force `force` (at load factor 1) along `direction` (normalised here; must be non-zero).
+    pub fn new(direction: [f64; 3], force: f64) -> crate::Result<Self> {
+        let n = Vector3::from(direction);
+        let len = n.norm();
+        if !(len > 0.0 && len.is_finite() && force.is_finite()) {
+            return Err(crate::StampError::Problem(format!("a force-driven punch needs a finite, non-zero direction and a finite force, got {direction:?} and {force}")));
+        }
+        Ok(ForceDrive { direction: (n / len).into(), force, dof: usize::MAX })
+    }
+}
+
+/// The default regularisation parameter: the penalty stiffness of a contact point per unit area and
+/// unit penetration, k = eps_reg |grad Psi|^2 (q_n = eps_reg |grad Psi|^2 g for a penetration
+/// g = -Psi / |grad Psi|), is set to [`AUTO_EPS_FACTOR`] times `membrane_stiffness / element_size^2`
+/// (E h / l_e^2 for a plate): the contact spring k l_e^2 of one node is 100 times the membrane
+/// stiffness E h of the plate around it: far stiffer than the plate's bending, yet far from the
+/// round-off floor of the residual (a multiple of the stiffest element stiffness, not 1e7 times it).
+/// The penetration is then about q_n l_e^2 / (100 E h); [`ContactPair::augment`] removes it when a
+/// tolerance is asked for. `grad_norm` is |grad Psi| on the punch surface where it touches
+/// ([`ContactPair::contact_gradient_norm`]: 2R for a sphere or cylinder written as |x - c|^2 - R^2,
+/// 1 for a plane).
+pub fn automatic_eps_reg(membrane_stiffness: f64, element_size: f64, grad_norm: f64) -> f64 {
+    AUTO_EPS_FACTOR * membrane_stiffness / (element_size * element_size * grad_norm * grad_norm)
+}
+
+/// The factor c of [`automatic_eps_reg`].
+pub const AUTO_EPS_FACTOR: f64 = 100.0;
 
 /// One point that may touch the punch: its reference position, the global dofs of its
 /// displacement (three components) and its weight (tributary area).
@@ -55,8 +107,11 @@ pub struct PointState {
 pub struct ContactPair {
     pub name: String,
     pub surface: Arc<dyn ContactSurface>,
-    /// Punch displacement at load factor 1; at load factor t the punch is moved by t * motion.
+    /// Punch displacement at load factor 1; at load factor t the punch is moved by t * motion
+    /// (plus s * direction when it is force-driven).
     pub motion: [f64; 3],
+    /// Pressed by a prescribed force: its displacement along a direction is an unknown.
+    pub drive: Option<ForceDrive>,
     pub points: Vec<ContactPoint>,
     /// The regularisation parameter eps_reg (force per unit area per unit of Psi).
     pub eps_reg: f64,
@@ -94,6 +149,7 @@ impl ContactPair {
             name: name.into(),
             surface,
             motion: [0.0; 3],
+            drive: None,
             points,
             eps_reg,
             kinematics,
@@ -116,12 +172,49 @@ impl ContactPair {
         self.lambda_scale = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
     }
 
-    /// Evaluate Psi, the multipliers and the active set at the full displacement vector `u` and
-    /// load factor `t`, add the contact forces lambda * w * grad Psi into `force` and, through
-    /// `add_tangent(row_dof, col_dof, value)`, the tangent w (eps grad Psi grad Psi^T + lambda Hess Psi)
-    /// of the active points. Returns the number of points whose active state changed.
+    /// The punch displacement at load factor `t` for the unknowns `u`: t * motion, plus s * direction
+    /// when force-driven.
+    pub fn punch_displacement(&self, u: &[f64], t: f64) -> [f64; 3] {
+        let mut d = Vector3::from(self.motion) * t;
+        if let Some(f) = &self.drive {
+            d += Vector3::from(f.direction) * u[f.dof];
+        }
+        d.into()
+    }
+
+    /// The unknown displacement s of a force-driven punch along its direction.
+    pub fn drive_displacement(&self, u: &[f64]) -> Option<f64> {
+        self.drive.as_ref().map(|f| u[f.dof])
+    }
+
+    /// |grad Psi| at the candidate point closest to the punch (smallest Psi / |grad Psi|) in the
+    /// reference configuration: the gradient scale of [`automatic_eps_reg`]. 1 with no points.
+    pub fn contact_gradient_norm(&self) -> f64 {
+        let mut best = (f64::INFINITY, 1.0);
+        for p in &self.points {
+            let x = Vector3::from(p.x_ref);
+            let g = self.surface.gradient(&x).norm();
+            if g > 0.0 && g.is_finite() {
+                let gap = self.surface.psi(&x) / g;
+                if gap < best.0 {
+                    best = (gap, g);
+                }
+            }
+        }
+        best.1
+    }
+
+    /// Evaluate Psi, the multipliers and the active set at the full unknown vector `u` and load
+    /// factor `t`, add the contact forces lambda * w * grad Psi into `force` and, through
+    /// `add_tangent(row, col, value)` (indices into `u`), the tangent w (eps G G^T + lambda H) of the
+    /// active points, G and H the gradient and Hessian of Psi with respect to the point's
+    /// displacement (and to s for a force-driven punch, whose equation R_s = sum w lambda dPsi/ds
+    /// - t F is added into `force[drive.dof]`). Returns the number of points whose active state
+    /// changed.
     pub fn evaluate(&mut self, u: &[f64], t: f64, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>) -> usize {
-        let d = Vector3::from(self.motion) * t;
+        let d = Vector3::from(self.punch_displacement(u, t));
+        let drive = self.drive;
+        let dn = drive.map(|f| Vector3::from(f.direction)).unwrap_or_else(Vector3::zeros);
         let mut changes = 0;
         let with_tangent = add_tangent.is_some();
         let first = !self.initialized;
@@ -130,20 +223,26 @@ impl ContactPair {
         let current = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
         self.lambda_scale = self.lambda_scale.max(current);
         let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
+        let mut any_tangent = false;
         for (k, p) in self.points.iter().enumerate() {
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
-            let (psi, grad, hess) = match self.kinematics {
+            // Psi, its gradient with respect to the point's displacement and to s, the Hessian point
+            let (psi, grad, grad_s, hess) = match self.kinematics {
                 ContactKinematics::Exact => {
                     let x = x_ref + disp - d;
-                    (self.surface.psi(&x), self.surface.gradient(&x), Some(x))
+                    let g = self.surface.gradient(&x);
+                    (self.surface.psi(&x), g, -g.dot(&dn), Some(x))
                 }
                 ContactKinematics::Shallow { direction } => {
+                    // linearised about the reference position and the prescribed motion: in the
+                    // plate's displacement along n and in the punch's unknown s
                     let n = Vector3::from(direction);
-                    let x0 = x_ref - d;
+                    let x0 = x_ref - Vector3::from(self.motion) * t;
                     let g0 = self.surface.gradient(&x0);
                     let gn = g0.dot(&n);
-                    (self.surface.psi(&x0) + gn * disp.dot(&n), n * gn, None)
+                    let s = drive.map(|f| u[f.dof]).unwrap_or(0.0);
+                    (self.surface.psi(&x0) + gn * disp.dot(&n) - g0.dot(&dn) * s, n * gn, -g0.dot(&dn), None)
                 }
             };
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
@@ -175,18 +274,54 @@ impl ContactPair {
             if !active && !near_kink {
                 continue;
             }
+            any_tangent = true;
             let w = p.weight;
             for i in 0..3 {
                 force[p.dofs[i]] += w * lambda * grad[i];
             }
+            if let Some(f) = &drive {
+                force[f.dof] += w * lambda * grad_s;
+            }
             if let Some(add) = add_tangent.as_deref_mut() {
-                let mut kt: Matrix3<f64> = grad * grad.transpose() * (w * self.eps_reg);
-                if let Some(x) = hess {
-                    kt += self.surface.hessian(&x) * (w * lambda);
-                }
-                for i in 0..3 {
-                    for j in 0..3 {
-                        add(p.dofs[i], p.dofs[j], kt[(i, j)]);
+                point_tangent(&*self.surface, p, drive.as_ref(), &dn, &grad, grad_s, hess.as_ref(), w * self.eps_reg, w * lambda, add);
+            }
+        }
+        if let Some(f) = &drive {
+            force[f.dof] -= t * f.force;
+            // With no point in contact the punch's equation has no stiffness (it floats) and no state
+            // is an equilibrium unless t F = 0. Keep the point closest to the punch on its active
+            // branch, lambda = lambda_bar + eps Psi even where that pulls: Newton then brings the
+            // punch onto the plate in one step instead of creeping towards it. Once a point
+            // touches, this stops; at t F = 0 the punch rests touching the plate with no force.
+            if !any_tangent {
+                let closest = self
+                    .state
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, s)| Vector3::from(s.grad).norm() > 0.0)
+                    .min_by(|a, b| (a.1.psi / Vector3::from(a.1.grad).norm()).total_cmp(&(b.1.psi / Vector3::from(b.1.grad).norm())))
+                    .map(|(k, _)| k);
+                if let Some(k) = closest {
+                    let p = &self.points[k];
+                    let g = Vector3::from(self.state[k].grad);
+                    let lambda = self.lambda_bar[k] + self.eps_reg * self.state[k].psi;
+                    let (grad_s, hess_at) = match self.kinematics {
+                        ContactKinematics::Exact => {
+                            let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
+                            (-g.dot(&dn), Some(Vector3::from(p.x_ref) + disp - d))
+                        }
+                        ContactKinematics::Shallow { .. } => {
+                            let x0 = Vector3::from(p.x_ref) - Vector3::from(self.motion) * t;
+                            (-self.surface.gradient(&x0).dot(&dn), None)
+                        }
+                    };
+                    self.state[k].lambda = lambda;
+                    for i in 0..3 {
+                        force[p.dofs[i]] += p.weight * lambda * g[i];
+                    }
+                    force[f.dof] += p.weight * lambda * grad_s;
+                    if let Some(add) = add_tangent.as_deref_mut() {
+                        point_tangent(&*self.surface, p, Some(f), &dn, &g, grad_s, hess_at.as_ref(), p.weight * self.eps_reg, p.weight * lambda, add);
                     }
                 }
             }
@@ -226,6 +361,24 @@ impl ContactPair {
         self.max_penetration()
     }
 
+    /// How far the augmented-Lagrangian multipliers are from converged, as a length: the largest
+    /// penetration over all points and the largest gap |Psi| / |grad Psi| of the active points
+    /// (an active point with a gap carries more than its share, lambda_bar too large: after
+    /// unloading it would press the plate down with a force the load no longer provides).
+    pub fn constraint_violation(&self) -> f64 {
+        let gaps = self
+            .state
+            .iter()
+            .zip(&self.lambda_bar)
+            .filter(|(s, lb)| s.active && **lb < 0.0)
+            .map(|(s, _)| {
+                let g = Vector3::from(s.grad).norm();
+                if g > 0.0 { s.psi.abs() / g } else { 0.0 }
+            })
+            .fold(0.0, f64::max);
+        gaps.max(self.max_penetration())
+    }
+
     /// The largest penetration max(0, -Psi) over the points, in units of Psi divided by
     /// |grad Psi| (a length for any surface).
     pub fn max_penetration(&self) -> f64 {
@@ -263,6 +416,36 @@ impl ContactPair {
     /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point.
     pub fn pressures(&self) -> Vec<f64> {
         self.state.iter().map(|s| -s.lambda * Vector3::from(s.grad).norm()).collect()
+    }
+}
+
+/// Add the tangent of one contact point: w eps G G^T + w lambda H over the point's three
+/// displacement dofs and, for a force-driven punch, its unknown s (G_s = dPsi/ds = -grad Psi . n,
+/// H_us = -H n, H_ss = n^T H n). `hess_at` is where the Hessian is taken (None: no curvature term).
+#[allow(clippy::too_many_arguments)]
+fn point_tangent(surface: &dyn ContactSurface, p: &ContactPoint, drive: Option<&ForceDrive>, dn: &Vector3<f64>, grad: &Vector3<f64>, grad_s: f64, hess_at: Option<&Vector3<f64>>, w_eps: f64, w_lambda: f64, add: &mut dyn FnMut(usize, usize, f64)) {
+    let mut kt: Matrix3<f64> = grad * grad.transpose() * w_eps;
+    let mut hn = Vector3::zeros();
+    let mut nhn = 0.0;
+    if let Some(x) = hess_at {
+        let h = surface.hessian(x);
+        kt += h * w_lambda;
+        hn = h * dn;
+        nhn = dn.dot(&hn);
+    }
+    for i in 0..3 {
+        for j in 0..3 {
+            add(p.dofs[i], p.dofs[j], kt[(i, j)]);
+        }
+    }
+    if let Some(f) = drive {
+        for i in 0..3 {
+            // d(force_i)/ds and d(R_s)/du_i
+            let v = w_eps * grad[i] * grad_s - w_lambda * hn[i];
+            add(p.dofs[i], f.dof, v);
+            add(f.dof, p.dofs[i], v);
+        }
+        add(f.dof, f.dof, w_eps * grad_s * grad_s + w_lambda * nhn);
     }
 }
 

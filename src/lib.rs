@@ -15,6 +15,7 @@ pub use error::{Result, StampError};
 pub mod dofs;
 pub mod element;
 pub mod linear_solver;
+pub mod bordered;
 pub mod sparse;
 pub mod assembly;
 pub mod contact;

@@ -1,5 +1,11 @@
 //! A model: one element set on a mesh, its dofs and constraints, nodal loads and punches. It is the
 //! [`NonlinearProblem`] the solver drives: R(u, t) = f_int(u) + f_contact(u, t) - t f_ext.
+//!
+//! The unknowns are the nodal dofs (node-major, as in [`DofMap`]) followed by one displacement per
+//! force-driven punch (see [`crate::contact::ForceDrive`]), in the order of `contacts`; so are the
+//! equations: the punch's equilibrium is appended after the nodal equations and the sparse
+//! pattern is bordered by one row and column per such punch, coupled to its candidate points'
+//! dofs, so the same sparse LU solves the whole system.
 
 use crate::assembly::Assembler;
 use crate::contact::{ContactPair, PointState};
@@ -26,10 +32,15 @@ pub struct Model<E: Element> {
     /// Nodal forces (dof, value at load factor 1).
     pub loads: Vec<(usize, f64)>,
     pub contacts: Vec<ContactPair>,
-    /// Augmented-Lagrangian tolerance on the penetration (a length); `None` for the plain perturbed
-    /// Lagrangian.
+    /// Augmented-Lagrangian tolerance on the penetration (a length; see
+    /// [`ContactPair::constraint_violation`]); `None` for the plain perturbed Lagrangian.
     pub augmented_tolerance: Option<f64>,
     pattern: SparsePattern,
+    /// The nodal pattern (without the force-driven punches' border).
+    nodal_pattern: SparsePattern,
+    /// Per force-driven punch: (index in `contacts`, number of candidate points) the pattern was
+    /// bordered for.
+    border: Vec<(usize, usize)>,
     assembler: Assembler,
     /// Internal + contact force over all dofs at the last evaluation (reactions at prescribed dofs).
     force: Vec<f64>,
@@ -37,6 +48,9 @@ pub struct Model<E: Element> {
     residual: Vec<f64>,
     energy: f64,
     saved: Vec<(Vec<f64>, Vec<PointState>, Vec<bool>)>,
+    /// Force scale of the last evaluation, and the largest over the converged steps so far.
+    last_scale: f64,
+    peak_scale: f64,
     pub timings: ModelTimings,
 }
 
@@ -65,10 +79,14 @@ impl<E: Element> Model<E> {
             loads: Vec::new(),
             contacts: Vec::new(),
             augmented_tolerance: None,
+            nodal_pattern: pattern.clone(),
             pattern,
+            border: Vec::new(),
             assembler,
             energy: 0.0,
             saved: Vec::new(),
+            last_scale: 0.0,
+            peak_scale: 0.0,
             timings: ModelTimings::default(),
         })
     }
@@ -82,10 +100,52 @@ impl<E: Element> Model<E> {
         Ok(())
     }
 
-    /// Internal + contact forces over all dofs at the last evaluation; at prescribed dofs these are
-    /// the support reactions (plus any load applied there): the force the support exerts on the body.
+    /// Internal + contact forces over all nodal dofs at the last evaluation; at prescribed dofs
+    /// these are the support reactions (plus any load applied there): the force the support exerts
+    /// on the body.
     pub fn nodal_forces(&self) -> &[f64] {
-        &self.force
+        &self.force[..self.dofs.num_dofs()]
+    }
+
+    /// Add a punch; a force-driven one gets its unknown (after the nodal dofs and the earlier
+    /// force-driven punches) and borders the pattern. Pushing onto `contacts` directly works too:
+    /// the model catches up at the next evaluation, but [`NonlinearProblem::num_dofs`] and
+    /// `num_equations` count the punches at once.
+    pub fn add_contact(&mut self, pair: ContactPair) {
+        self.contacts.push(pair);
+        self.sync_drives();
+    }
+
+    /// Number of force-driven punches (extra unknowns).
+    pub fn num_drives(&self) -> usize {
+        self.contacts.iter().filter(|c| c.drive.is_some()).count()
+    }
+
+    /// Number each force-driven punch's unknown and border the pattern for them (when they
+    /// changed).
+    fn sync_drives(&mut self) {
+        let nd = self.dofs.num_dofs();
+        let mut sig = Vec::new();
+        for (i, c) in self.contacts.iter_mut().enumerate() {
+            if let Some(f) = c.drive.as_mut() {
+                f.dof = nd + sig.len();
+                sig.push((i, c.points.len()));
+            }
+        }
+        if sig == self.border {
+            return;
+        }
+        if sig.is_empty() {
+            self.pattern = self.nodal_pattern.clone();
+        } else {
+            let border: Vec<Vec<usize>> = sig.iter().map(|&(i, _)| self.contacts[i].points.iter().flat_map(|p| p.dofs).collect()).collect();
+            self.pattern = self.nodal_pattern.bordered(&self.dofs, &border);
+        }
+        self.border = sig;
+        let nb = self.border.len();
+        self.force.resize(nd + nb, 0.0);
+        self.residual.resize(self.dofs.num_equations() + nb, 0.0);
+        self.values = vec![0.0; self.pattern.nnz()];
     }
 
     /// Strain energy at the last evaluation.
@@ -106,42 +166,58 @@ impl<E: Element> Model<E> {
 
 impl<E: Element> NonlinearProblem for Model<E> {
     fn num_dofs(&self) -> usize {
-        self.dofs.num_dofs()
+        self.dofs.num_dofs() + self.num_drives()
     }
     fn num_equations(&self) -> usize {
-        self.dofs.num_equations()
+        self.dofs.num_equations() + self.num_drives()
     }
     fn apply_prescribed(&self, u: &mut [f64], t: f64) {
         self.dofs.apply_prescribed(u, t);
     }
 
     fn evaluate(&mut self, u: &[f64], t: f64, with_tangent: bool) -> Result<Evaluation> {
+        self.sync_drives();
+        let nd = self.dofs.num_dofs();
+        let neq = self.dofs.num_equations();
+        if u.len() != nd + self.border.len() {
+            return Err(StampError::Problem(format!("the unknown vector has {} entries, the model {} (nodal dofs and force-driven punches)", u.len(), nd + self.border.len())));
+        }
         let start = Instant::now();
         let values = if with_tangent { Some(self.values.as_mut_slice()) } else { None };
-        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force, values);
+        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values);
+        self.force[nd..].fill(0.0);
         let internal_norm = self.force.iter().map(|x| x * x).sum::<f64>().sqrt();
         let t_contact = Instant::now();
         self.timings.assembly += (t_contact - start).as_secs_f64();
         self.timings.assemblies += 1;
         let mut changes = 0;
         let mut contact_sq = 0.0;
+        let mut ext_sq = 0.0;
         {
             let pattern = &self.pattern;
             let dofs = &self.dofs;
             let values = &mut self.values;
+            let eq = |d: usize| if d < nd { dofs.equation(d) } else { Some(neq + d - nd) };
             let mut add = |r: usize, c: usize, v: f64| {
-                if let Some(s) = pattern.nodal_slot(dofs, r, c) {
-                    values[s] += v;
+                if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
+                    if let Some(s) = pattern.find(re, ce) {
+                        values[s] += v;
+                    }
                 }
             };
             for pair in self.contacts.iter_mut() {
                 changes += if with_tangent { pair.evaluate(u, t, &mut self.force, Some(&mut add)) } else { pair.evaluate(u, t, &mut self.force, None) };
                 contact_sq += pair.force_norm().powi(2);
+                if let Some(f) = &pair.drive {
+                    ext_sq += (t * f.force).powi(2);
+                }
             }
         }
         self.timings.contact += t_contact.elapsed().as_secs_f64();
-        let mut ext_sq = 0.0;
-        self.dofs.gather(&self.force, &mut self.residual);
+        self.dofs.gather(&self.force[..nd], &mut self.residual[..neq]);
+        for k in 0..self.border.len() {
+            self.residual[neq + k] = self.force[nd + k];
+        }
         for &(d, v) in &self.loads {
             ext_sq += (t * v) * (t * v);
             if let Some(e) = self.dofs.equation(d) {
@@ -152,7 +228,12 @@ impl<E: Element> NonlinearProblem for Model<E> {
         if !norm.is_finite() {
             return Err(StampError::NonFinite(format!("the residual at load factor {t} is not finite (element or contact produced NaN)")));
         }
-        let scale = internal_norm.max(ext_sq.sqrt()).max(contact_sq.sqrt());
+        // The internal forces carry a round-off that does not vanish with the load (Green-Lagrange
+        // strains from positions): back at zero load the forces in play would be that round-off
+        // alone. So the scale never drops below 1e-3 of the largest converged one (a tolerance of
+        // rel_tol * 1e-3 of the peak forces: no loosening that matters).
+        let scale = internal_norm.max(ext_sq.sqrt()).max(contact_sq.sqrt()).max(1e-3 * self.peak_scale);
+        self.last_scale = scale;
         Ok(Evaluation { residual_norm: norm, force_scale: scale, active_changes: changes })
     }
 
@@ -164,6 +245,10 @@ impl<E: Element> NonlinearProblem for Model<E> {
     }
     fn add_increment(&self, u: &mut [f64], du: &[f64]) {
         self.dofs.add_increment(u, du);
+        let (nd, neq) = (self.dofs.num_dofs(), self.dofs.num_equations());
+        for k in 0..self.num_drives() {
+            u[nd + k] += du[neq + k];
+        }
     }
     fn update_active_set(&mut self) -> usize {
         self.contacts.iter_mut().map(|c| c.update_active_set()).sum()
@@ -177,7 +262,9 @@ impl<E: Element> NonlinearProblem for Model<E> {
         let Some(tol) = self.augmented_tolerance else { return false };
         let mut again = false;
         for c in self.contacts.iter_mut() {
-            if c.max_penetration() > tol {
+            // both ways: a penetration above the tolerance, or an active point whose multiplier
+            // lambda_bar holds it off the punch (a gap) by more than the tolerance
+            if c.constraint_violation() > tol {
                 c.augment();
                 again = true;
             }
@@ -185,6 +272,9 @@ impl<E: Element> NonlinearProblem for Model<E> {
         again
     }
     fn checkpoint(&mut self) {
+        // called after a converged step (and once before the first): its last evaluation is the
+        // converged state's
+        self.peak_scale = self.peak_scale.max(self.last_scale);
         self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone(), c.last_active.clone())).collect();
     }
     fn restore(&mut self) {

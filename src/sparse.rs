@@ -11,6 +11,7 @@ use crate::error::{Result, StampError};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 
 /// The compressed-column pattern of the global matrix and the element-to-slot maps.
+#[derive(Clone)]
 pub struct SparsePattern {
     symbolic: SymbolicSparseColMat<usize>,
     /// For element e, `nodes_per_element^2` entries: offset of node a's rows inside the columns of
@@ -141,6 +142,54 @@ impl SparsePattern {
         }
         let symbolic = SymbolicSparseColMat::new_checked(neq, neq, col_ptr, None, row_idx);
         Ok(SparsePattern { symbolic, block_start, rank, nodes_per_element: npe })
+    }
+
+    /// The same pattern bordered by `border.len()` extra equations appended after the nodal ones:
+    /// extra equation k couples with itself and with the equations of the dofs `border[k]`
+    /// (prescribed dofs are skipped), in its row and in its column. The nodal columns keep their
+    /// rows first, so element slots ([`slot`](Self::slot)) are unchanged.
+    pub fn bordered(&self, dofs: &DofMap, border: &[Vec<usize>]) -> SparsePattern {
+        let n0 = self.size();
+        let nb = border.len();
+        let mut coupled: Vec<Vec<usize>> = border.iter().map(|ds| {
+            let mut v: Vec<usize> = ds.iter().filter_map(|&d| dofs.equation(d)).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        }).collect();
+        // extra rows of every nodal column
+        let mut extra_rows: Vec<Vec<usize>> = vec![Vec::new(); n0];
+        for (k, eqs) in coupled.iter().enumerate() {
+            for &e in eqs {
+                extra_rows[e].push(n0 + k);
+            }
+        }
+        let (cp, ri) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        let mut col_ptr = Vec::with_capacity(n0 + nb + 1);
+        let mut row_idx = Vec::with_capacity(ri.len() + 2 * coupled.iter().map(|c| c.len()).sum::<usize>() + nb);
+        col_ptr.push(0);
+        for j in 0..n0 {
+            row_idx.extend_from_slice(&ri[cp[j]..cp[j + 1]]);
+            row_idx.extend_from_slice(&extra_rows[j]);
+            col_ptr.push(row_idx.len());
+        }
+        for (k, eqs) in coupled.iter_mut().enumerate() {
+            eqs.push(n0 + k);
+            row_idx.extend_from_slice(eqs);
+            col_ptr.push(row_idx.len());
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(n0 + nb, n0 + nb, col_ptr, None, row_idx);
+        SparsePattern { symbolic, block_start: self.block_start.clone(), rank: self.rank.clone(), nodes_per_element: self.nodes_per_element }
+    }
+
+    /// Slot of the entry (row equation, column equation), if it is in the pattern (binary search).
+    pub fn find(&self, row_eq: usize, col_eq: usize) -> Option<usize> {
+        let cp = self.symbolic.col_ptr();
+        if col_eq + 1 >= cp.len() {
+            return None;
+        }
+        let col = cp[col_eq]..cp[col_eq + 1];
+        self.symbolic.row_idx()[col.clone()].binary_search(&row_eq).ok().map(|p| col.start + p)
     }
 
     /// Number of stored entries.

@@ -1,10 +1,11 @@
 //! The assembled tangent of a whole model (plate elements plus contact with a curved punch) is the
 //! derivative of its residual: compared with central finite differences at a random
-//! large-displacement state with many points in contact.
+//! large-displacement state with many points in contact, with the punch moved by a prescribed
+//! displacement or pressed by a force (its displacement then an unknown with its own equation).
 
 mod common;
 use common::*;
-use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
+use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
@@ -25,7 +26,7 @@ fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
     d
 }
 
-fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed: u64) {
+fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed: u64, drive: Option<[f64; 3]>) {
     let mut mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 3, 3).unwrap();
     // distort the interior nodes
     let mut rng = Lcg(seed);
@@ -45,7 +46,18 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
     let points = (0..mesh.num_nodes())
         .map(|n| ContactPoint { node: n, x_ref: [mesh.coords[n][0], mesh.coords[n][1], dp], dofs: [0, 1, 2].map(|c| Face::Top.dof(n, c)), weight: areas[n] })
         .collect();
-    model.contacts.push(ContactPair::new("punch", surface, points, 3.0e3, ContactKinematics::Exact));
+    let ck = match kin {
+        Kinematics::Nonlinear => ContactKinematics::Exact,
+        Kinematics::Linear => ContactKinematics::Shallow { direction: [0.0, 0.0, 1.0] },
+    };
+    let mut pair = ContactPair::new("punch", surface, points, 3.0e3, ck);
+    pair.motion = [0.01, -0.02, -0.05];
+    if let Some(n) = drive {
+        pair.drive = Some(ForceDrive::new(n, 7.0).unwrap());
+    }
+    model.add_contact(pair);
+    assert_eq!(model.num_dofs(), model.dofs.num_dofs() + drive.is_some() as usize);
+    assert_eq!(model.num_equations(), model.dofs.num_equations() + drive.is_some() as usize);
     let mut u: Vec<f64> = (0..model.num_dofs()).map(|_| rng.range(-0.3, 0.3)).collect();
     model.apply_prescribed(&mut u, 1.0);
     model.evaluate(&u, 1.0, true).unwrap();
@@ -79,17 +91,51 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
         }
     }
     assert!(worst < 1e-6, "model tangent differs from finite differences by {worst:e}");
+    if drive.is_some() {
+        // the punch's row and column are really there (a tangent of zeros would pass above only if
+        // the residual ignored s too)
+        let s = neq - 1;
+        let coupling = (0..neq - 1).map(|i| k[i][s].abs() + k[s][i].abs()).fold(0.0, f64::max);
+        assert!(k[s][s].abs() > 1e-3 * scale && coupling > 1e-3 * scale, "K_ss = {}, largest coupling {coupling:e}", k[s][s]);
+        // the bordered solver (block elimination) gives the sparse LU's solution of the whole system
+        use stamp::linear_solver::LinearSolver;
+        model.evaluate(&u, 1.0, true).unwrap();
+        let r = model.residual().to_vec();
+        let mut x_lu = r.clone();
+        let mut lu = stamp::linear_solver::SparseLu::new();
+        lu.factorize(model.matrix()).unwrap();
+        lu.solve_in_place(&mut x_lu).unwrap();
+        let mut x_b = r.clone();
+        let mut b = stamp::bordered::BorderedLu::new(1);
+        b.factorize(model.matrix()).unwrap();
+        b.solve_in_place(&mut x_b).unwrap();
+        let norm = x_lu.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let diff = x_lu.iter().zip(&x_b).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(diff < 1e-8 * norm, "bordered solve differs from the full LU by {diff:e} (|x| = {norm:e})");
+    }
 }
 
 #[test]
 fn model_tangent_with_sphere_contact_matches_finite_differences() {
     let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
-    check(Arc::new(s), Kinematics::Nonlinear, 11);
+    check(Arc::new(s), Kinematics::Nonlinear, 11, None);
+}
+
+#[test]
+fn model_tangent_with_a_force_driven_punch_matches_finite_differences() {
+    // the punch's displacement along its direction is an unknown; an oblique direction exercises
+    // every coupling term (grad Psi . n, H n, n^T H n)
+    let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    check(Arc::new(s), Kinematics::Nonlinear, 21, Some([0.3, -0.2, -1.0]));
+    let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
+    check(Arc::new(c), Kinematics::Nonlinear, 22, Some([0.0, 0.0, -1.0]));
+    let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    check(Arc::new(s), Kinematics::Linear, 23, Some([0.0, 0.0, -1.0]));
 }
 
 #[test]
 fn model_tangent_with_cylinder_contact_matches_finite_differences() {
     let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
-    check(Arc::new(c), Kinematics::Nonlinear, 12);
-    check(Arc::new(Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap()), Kinematics::Linear, 13);
+    check(Arc::new(c), Kinematics::Nonlinear, 12, None);
+    check(Arc::new(Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap()), Kinematics::Linear, 13, None);
 }

@@ -148,9 +148,14 @@ fn bad_problem_files_name_the_key_line_or_group() {
     // a sphere without a radius
     let e = error_of("sphere", &format!("{CANTILEVER}\n[[punch]]\nshape = \"sphere\"\ncenter = [0.0, 50.0, 5.0]\n"));
     assert!(e.contains("punch[0]") && e.contains("radius"), "{e}");
-    // decreasing targets
-    let e = error_of("targets", &format!("{CANTILEVER}\n[solver]\ntargets = [0.5, 0.2]\n"));
-    assert!(e.contains("increasing") && e.contains("line 22"), "{e}");
+    // targets may go down again (unloading), but not repeat or go below zero
+    let e = error_of("targets", &format!("{CANTILEVER}\n[solver]\ntargets = [0.5, 0.5]\n"));
+    assert!(e.contains("differ from the one before") && e.contains("line 22"), "{e}");
+    let e = error_of("negative_target", &format!("{CANTILEVER}\n[solver]\ntargets = [0.5, -0.2]\n"));
+    assert!(e.contains(">= 0") && e.contains("line 22"), "{e}");
+    // a punch with both a motion and a force
+    let e = error_of("force_and_motion", &format!("{CANTILEVER}\n[[punch]]\nshape = \"sphere\"\ncenter = [0.0, 50.0, 5.0]\nradius = 4.0\nmotion = [0.0, 0.0, -1.0]\nforce = 3.0\n"));
+    assert!(e.contains("punch[0].force") && e.contains("not both"), "{e}");
     // a missing mesh file
     let e = error_of("mesh_file", &CANTILEVER.replace("rectangle = { x = [0.0, 1.0], y = [0.0, 100.0], n = [1, 40] }", "file = \"nope.msh\""));
     assert!(e.contains("nope.msh") && e.contains("mesh.file"), "{e}");

@@ -15,17 +15,20 @@
 //! * Punches: the candidate points are the nodes of `group` (default: all) on the touched face
 //!   (x3 = delta+ for `top`, delta- for `bottom`), weighted by their tributary area over the group's
 //!   cells when the group is a surface, over the whole mesh otherwise.
-//! * Automatic eps_reg: the penalty stiffness of a contact point per unit area and unit penetration
-//!   is k = eps_reg |grad Psi|^2 (q_n = -lambda |grad Psi| = eps_reg |grad Psi|^2 g for a penetration
-//!   g = -Psi / |grad Psi|). We choose k = 100 E h / l_e^2, l_e the square root of the mean cell
-//!   area: a node's contact spring k l_e^2 is 100 times the membrane stiffness E h of the plate
-//!   around it. |grad Psi| on the punch surface is 2R for a cylinder or sphere and 1 for a plane,
-//!   so eps_reg = 100 E h / (l_e^2 |grad Psi|^2). The penetration is then about q_n l_e^2 / (100 E h).
+//! * Automatic eps_reg: [`stamp::contact::automatic_eps_reg`] with the membrane stiffness E h, l_e
+//!   the square root of the mean cell area and |grad Psi| at the candidate point closest to the punch
+//!   ([`ContactPair::contact_gradient_norm`]: 2R for a touching cylinder or sphere, 1 for a plane),
+//!   so eps_reg = 100 E h / (l_e^2 |grad Psi|^2). The penetration is then about q_n l_e^2 / (100 E h);
+//!   `penetration_tolerance` adds augmented-Lagrangian updates until it is below the tolerance.
+//! * A punch is displacement driven (`motion`, times the load factor) or force driven (`force`
+//!   times the load factor along `direction`, default towards the plate): its displacement along
+//!   `direction` is then an unknown, reported per step in summary.json. It may start off the plate:
+//!   while nothing touches, the closest point pulls it down (see `ContactPair::evaluate`).
 
 use super::mesh::{group_error, MeshData};
 use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Problem, PunchFace, Shape};
 use nalgebra::Vector3;
-use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
+use stamp::contact::{automatic_eps_reg, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
 use stamp::model::Model;
 use stamp::nonlinear::NewtonSettings;
@@ -36,7 +39,7 @@ use stamp_elements::{Face, Isotropic, Kinematics, PlateElements, Section};
 use std::sync::Arc;
 
 /// Factor c of the automatic eps_reg (see the module notes).
-pub const AUTO_EPS_FACTOR: f64 = 100.0;
+pub use stamp::contact::AUTO_EPS_FACTOR;
 
 /// What the output needs to know about a punch.
 pub struct PunchInfo {
@@ -182,16 +185,10 @@ pub fn build(p: &Problem) -> Result<Setup> {
         let name = p.punch_name(i);
         let key = format!("punch[{i}]");
         let wrap = |e: StampError| p.error_at(pu.span(), &key, e);
-        let (surface, grad_norm): (Arc<dyn ContactSurface>, f64) = match spec.shape {
-            Shape::Cylinder => {
-                let r = spec.radius.unwrap().0;
-                (Arc::new(Cylinder::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.axis.unwrap().0), r).map_err(wrap)?), 2.0 * r)
-            }
-            Shape::Sphere => {
-                let r = spec.radius.unwrap().0;
-                (Arc::new(Sphere::new(Vector3::from(spec.center.unwrap().0), r).map_err(wrap)?), 2.0 * r)
-            }
-            Shape::Plane => (Arc::new(Plane::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.normal.unwrap().0)).map_err(wrap)?), 1.0),
+        let surface: Arc<dyn ContactSurface> = match spec.shape {
+            Shape::Cylinder => Arc::new(Cylinder::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.axis.unwrap().0), spec.radius.unwrap().0).map_err(wrap)?),
+            Shape::Sphere => Arc::new(Sphere::new(Vector3::from(spec.center.unwrap().0), spec.radius.unwrap().0).map_err(wrap)?),
+            Shape::Plane => Arc::new(Plane::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.normal.unwrap().0)).map_err(wrap)?),
         };
         let face = face_of(spec.face);
         let z = match face {
@@ -217,10 +214,6 @@ pub fn build(p: &Problem) -> Result<Setup> {
                 ContactPoint { node: n, x_ref: [x[0], x[1], z], dofs: [0, 1, 2].map(|c| face.dof(n, c)), weight: weights[n] }
             })
             .collect();
-        let (eps_reg, eps_automatic) = match spec.eps_reg {
-            Some(e) => (e.0, false),
-            None => (AUTO_EPS_FACTOR * young * h / (le * le * grad_norm * grad_norm), true),
-        };
         let ck = match spec.kinematics {
             Some(ContactKinematicsSpec::Exact) => ContactKinematics::Exact,
             Some(ContactKinematicsSpec::Shallow) => ContactKinematics::Shallow { direction: [0.0, 0.0, 1.0] },
@@ -229,9 +222,21 @@ pub fn build(p: &Problem) -> Result<Setup> {
                 Kinematics::Linear => ContactKinematics::Shallow { direction: [0.0, 0.0, 1.0] },
             },
         };
-        let mut pair = ContactPair::new(name.clone(), surface.clone(), points, eps_reg, ck);
+        let mut pair = ContactPair::new(name.clone(), surface.clone(), points, 1.0, ck);
+        let (eps_reg, eps_automatic) = match spec.eps_reg {
+            Some(e) => (e.0, false),
+            None => (automatic_eps_reg(young * h, le, pair.contact_gradient_norm()), true),
+        };
+        pair.eps_reg = eps_reg;
         pair.motion = spec.motion.map(|m| m.0).unwrap_or([0.0; 3]);
-        model.contacts.push(pair);
+        if let Some(f) = spec.force {
+            let dir = spec.direction.map(|d| d.0).unwrap_or(match face {
+                Face::Top => [0.0, 0.0, -1.0],
+                Face::Bottom => [0.0, 0.0, 1.0],
+            });
+            pair.drive = Some(ForceDrive::new(dir, f.0).map_err(wrap)?);
+        }
+        model.add_contact(pair);
         if let Some(t) = spec.penetration_tolerance {
             tolerance = Some(tolerance.map_or(t.0, |x: f64| x.min(t.0)));
         }

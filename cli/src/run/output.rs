@@ -67,6 +67,12 @@ pub struct PointOut {
 pub struct PunchOut {
     /// Total force of this punch on the plate.
     pub reaction: [f64; 3],
+    /// The punch's rigid displacement (t * motion, plus s * direction when force driven).
+    pub displacement: [f64; 3],
+    /// Force-driven punch: its displacement s along `direction` (the unknown); null otherwise.
+    pub drive_displacement: Option<f64>,
+    /// Force-driven punch: the applied force t * force along `direction`; null otherwise.
+    pub applied_force: Option<f64>,
     pub active_nodes: usize,
     pub loaded_nodes: usize,
     pub loaded_zone: Option<BBox>,
@@ -80,6 +86,9 @@ pub struct PunchOut {
 pub struct StepEntry {
     pub step: usize,
     pub load_factor: f64,
+    /// Cumulative path length sum |delta t| from the start: the time of the step in the .pvd
+    /// (increases even when the load goes down again).
+    pub path: f64,
     pub is_target: bool,
     pub converged: bool,
     pub newton_iterations: usize,
@@ -92,6 +101,11 @@ pub struct StepEntry {
     pub loaded_zone: Option<BBox>,
     /// Total contact force on the plate (all punches).
     pub reaction: [f64; 3],
+    /// Total force of the supports (the prescribed dofs) on the plate.
+    pub support_reaction: [f64; 3],
+    /// Total applied load (nodal loads times the load factor). In equilibrium
+    /// applied_load + reaction + support_reaction = 0.
+    pub applied_load: [f64; 3],
     pub max_penetration: f64,
     pub points: BTreeMap<String, PointOut>,
     pub punches: BTreeMap<String, PunchOut>,
@@ -177,7 +191,7 @@ pub struct Context<'a> {
 }
 
 /// Fields, summary entry and CSV rows of the state `u` at load factor `t`.
-pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, report: &stamp::nonlinear::StepReport) -> StepData {
+pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, path: f64, report: &stamp::nonlinear::StepReport) -> StepData {
     let n = cx.mesh.mesh.num_nodes();
     let coords = &cx.mesh.mesh.coords;
     let mut lambda = vec![0.0; n];
@@ -225,7 +239,7 @@ pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, 
             });
         }
         // gap of the nodes that are not candidates: the exact gap of the touched face
-        let shift = Vector3::from(pair.motion) * t;
+        let shift = Vector3::from(pair.punch_displacement(u, t));
         for node in 0..n {
             if candidate[node] {
                 continue;
@@ -247,6 +261,9 @@ pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, 
             info.name.clone(),
             PunchOut {
                 reaction: r,
+                displacement: pair.punch_displacement(u, t),
+                drive_displacement: pair.drive_displacement(u),
+                applied_force: pair.drive.map(|f| t * f.force),
                 active_nodes: n_active,
                 loaded_nodes: p_loaded.len(),
                 loaded_zone: BBox::of(&p_loaded),
@@ -295,9 +312,26 @@ pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, 
             )
         })
         .collect();
+    // supports: at a prescribed dof the force of the support on the plate is the internal plus
+    // contact force there minus the applied load there
+    let mut support = [0.0; 3];
+    let mut applied = [0.0; 3];
+    let dpn = model.dofs.dofs_per_node();
+    for (d, f) in model.nodal_forces().iter().enumerate() {
+        if model.dofs.equation(d).is_none() {
+            support[(d % dpn) % 3] += f;
+        }
+    }
+    for &(d, v) in &model.loads {
+        applied[(d % dpn) % 3] += t * v;
+        if model.dofs.equation(d).is_none() {
+            support[(d % dpn) % 3] -= t * v;
+        }
+    }
     let entry = StepEntry {
         step: report.step,
         load_factor: t,
+        path,
         is_target: report.is_target,
         converged: true,
         newton_iterations: report.iterations,
@@ -307,6 +341,8 @@ pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, 
         loaded_nodes: loaded.iter().filter(|&&a| a > 0.0).count(),
         loaded_zone: BBox::of(&loaded_pts),
         reaction,
+        support_reaction: support,
+        applied_load: applied,
         max_penetration: max_pen,
         points,
         punches,

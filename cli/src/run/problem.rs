@@ -67,7 +67,8 @@ impl<'de> Deserialize<'de> for Direction {
     }
 }
 
-/// Increasing load factors, all > 0.
+/// Load factors to reach in turn: finite, >= 0, each different from the one before (the path starts
+/// at 0). They may go down again: loading, then unloading.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Targets(pub Vec<f64>);
 impl<'de> Deserialize<'de> for Targets {
@@ -78,8 +79,11 @@ impl<'de> Deserialize<'de> for Targets {
         }
         let mut last = 0.0;
         for &t in &v {
-            if !(t.is_finite() && t > last) {
-                return Err(D::Error::custom(format!("load factors must be finite, positive and increasing: {t} after {last}")));
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(D::Error::custom(format!("load factors must be finite and >= 0, got {t}")));
+            }
+            if t == last {
+                return Err(D::Error::custom(format!("each load factor must differ from the one before (the path starts at 0): {t} after {last}")));
             }
             last = t;
         }
@@ -309,9 +313,17 @@ pub struct PunchSpec {
     /// plane: the normal pointing out of the punch, towards the plate.
     #[serde(default)]
     pub normal: Option<Direction>,
-    /// Punch displacement at load factor 1.
+    /// Punch displacement at load factor 1 ...
     #[serde(default)]
     pub motion: Option<Vec3>,
+    /// ... or the force pressing the punch at load factor 1 (its displacement along `direction` is
+    /// then an unknown).
+    #[serde(default)]
+    pub force: Option<Finite>,
+    /// Direction of the force (default: towards the plate, -x3 for a punch on the top face, +x3 on
+    /// the bottom face).
+    #[serde(default)]
+    pub direction: Option<Direction>,
     #[serde(default)]
     pub face: PunchFace,
     /// Nodes that may touch (default: every node).
@@ -529,6 +541,12 @@ impl Problem {
                     ps.point.is_some() && ps.normal.is_some() && ps.radius.is_none() && ps.axis.is_none() && ps.center.is_none(),
                     "a plane needs `point` and `normal` (and no `radius`, `axis` or `center`)",
                 )?,
+            }
+            if ps.force.is_some() && ps.motion.is_some() {
+                return Err(self.error_at(p.span(), &format!("{key}.force"), "give `motion` (displacement driven) or `force` (force driven), not both"));
+            }
+            if ps.direction.is_some() && ps.force.is_none() {
+                return Err(self.error_at(p.span(), &format!("{key}.direction"), "`direction` is the direction of `force`; it needs `force`"));
             }
             let name = self.punch_name(i);
             if !names.insert(name.clone()) {

@@ -8,8 +8,8 @@ use super::problem::{PlotAxis, Problem};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use stamp::io::{write_pvd, write_string_atomically, write_vtu};
-use stamp::linear_solver::SparseLu;
-use stamp::nonlinear::{NewtonRaphson, NonlinearSolver};
+use stamp::bordered::BorderedLu;
+use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
 use stamp::{Result, StampError};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -31,7 +31,12 @@ struct PunchMeta {
     surface: String,
     face: String,
     motion: [f64; 3],
+    /// Force-driven punches: the force at load factor 1 and its direction.
+    force: Option<f64>,
+    direction: Option<[f64; 3]>,
     eps_reg: f64,
+    /// Augmented-Lagrangian tolerance on the penetration (null: plain perturbed Lagrangian).
+    penetration_tolerance: Option<f64>,
     eps_reg_automatic: bool,
     candidate_nodes: usize,
 }
@@ -60,15 +65,18 @@ struct Summary {
     steps: Vec<serde_json::Value>,
 }
 
-/// The progress bar: load factor along the bar, Newton iteration and residual in the message.
+/// The progress bar: the load path along the bar, Newton iteration and residual in the message.
+/// Without a terminal (and without --quiet) one terse line per converged step on stderr.
 struct Progress {
     bar: Option<ProgressBar>,
+    terse: bool,
     state: Arc<Mutex<(usize, f64)>>,
-    t_end: f64,
+    /// Total path length sum |delta t| over the targets.
+    path_end: f64,
 }
 
 impl Progress {
-    fn new(visible: bool, t_end: f64) -> Progress {
+    fn new(visible: bool, terse: bool, path_end: f64) -> Progress {
         let bar = visible.then(|| {
             let b = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
             b.set_style(
@@ -78,7 +86,7 @@ impl Progress {
             );
             b
         });
-        Progress { bar, state: Arc::new(Mutex::new((0, 0.0))), t_end }
+        Progress { bar, terse: terse && !visible, state: Arc::new(Mutex::new((0, 0.0))), path_end }
     }
 
     fn callback(&self) -> Option<Box<dyn FnMut(usize, f64, f64)>> {
@@ -91,11 +99,14 @@ impl Progress {
         }))
     }
 
-    fn step(&self, step: usize, t: f64, iterations: usize) {
+    fn step(&self, step: usize, t: f64, path: f64, iterations: usize, active: usize, penetration: f64) {
         *self.state.lock().unwrap() = (step, t);
+        let msg = format!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact, max penetration {penetration:.2e}");
         if let Some(b) = &self.bar {
-            b.set_position(((t / self.t_end) * 1000.0).round().clamp(0.0, 1000.0) as u64);
-            b.set_message(format!("step {step} converged at t = {t:.4} in {iterations} iterations"));
+            b.set_position(((path / self.path_end) * 1000.0).round().clamp(0.0, 1000.0) as u64);
+            b.set_message(msg);
+        } else if self.terse {
+            eprintln!("{msg}");
         }
     }
 
@@ -124,7 +135,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     let Setup { mesh, mut model, section, punches, targets, settings } = setup;
     let out = &p.spec.output;
     let stem = p.path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "step".into());
-    let t_end = *targets.last().unwrap_or(&1.0);
+    let path_end = targets.iter().fold((0.0, 0.0), |(len, last), &t| (len + (t - last).abs(), t)).0.max(f64::MIN_POSITIVE);
 
     // point groups reported in summary.json: named ones, and numbered ones without a name
     let mut point_groups: Vec<(String, Vec<usize>)> = mesh.points.iter().filter(|(k, _)| !k.starts_with('#')).map(|(k, v)| (k.clone(), v.clone())).collect();
@@ -178,7 +189,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
                 surface: i.surface.describe(),
                 face: format!("{:?}", i.face).to_lowercase(),
                 motion: c.motion,
+                force: c.drive.map(|f| f.force),
+                direction: c.drive.map(|f| f.direction),
                 eps_reg: i.eps_reg,
+                penetration_tolerance: model.augmented_tolerance,
                 eps_reg_automatic: i.eps_automatic,
                 candidate_nodes: c.points.len(),
             })
@@ -200,25 +214,32 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     let mut total_iterations = 0;
 
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
-    let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), t_end);
-    let mut newton = NewtonRaphson::new(SparseLu::new(), settings);
+    let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
+    // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
+    let mut newton = NewtonRaphson::new(BorderedLu::new(model.num_drives()), settings);
     newton.on_iteration = progress.callback();
-    let mut u = vec![0.0; model.dofs.num_dofs()];
+    let mut u = vec![0.0; model.num_dofs()];
+    let (mut path_len, mut t_last) = (0.0, 0.0);
     let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
         total_iterations += rep.iterations;
-        progress.step(rep.step, rep.load_factor, rep.iterations);
+        let t = rep.load_factor;
+        path_len += (t - t_last).abs();
+        t_last = t;
+        let penetration = m.contacts.iter().map(|c| c.max_penetration()).fold(0.0, f64::max);
+        let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
+        progress.step(rep.step, t, path_len, rep.iterations, active, penetration);
         if write_error.is_some() || !(out.every_step || rep.is_target) {
             return;
         }
-        let t = rep.load_factor;
-        let mut data = step_data(&cx, m, u, t, rep);
+        let mut data = step_data(&cx, m, u, t, path_len, rep);
         let step_result: Result<()> = (|| {
             if out.vtu {
                 let name = format!("{stem}_{:04}.vtu", rep.step);
                 let path = out_dir.join(&name);
                 write_vtu(&path, &mesh.mesh, &data.point_fields, &data.cell_fields)?;
                 files.push(path);
-                pvd.push((t, name.clone()));
+                // the .pvd time is the path length: it increases when the load goes down again
+                pvd.push((path_len, name.clone()));
                 write_pvd(&pvd_path, &pvd)?;
                 data.entry.vtu = Some(name);
             }

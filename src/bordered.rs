@@ -1,0 +1,189 @@
+//! A linear solver for a sparse matrix bordered by a few dense rows and columns,
+//!
+//! ```text
+//! [ A11  A12 ] [x1]   [b1]
+//! [ A21  A22 ] [x2] = [b2]      A11 sparse (n0 x n0), A12, A21 dense-ish, A22 small (m x m),
+//! ```
+//!
+//! such as the tangent of a model with force-driven punches (one extra unknown per punch, coupled to
+//! every candidate contact point: see [`crate::model::Model`]). A sparse LU of the whole matrix
+//! would see a dense row, and its symbolic phase (which bounds the factors by the Cholesky
+//! structure of A^T A) turns the block of every coupled column dense: several times slower than
+//! the nodal system alone. Block elimination keeps the sparse LU on A11 only:
+//! Y = A11^-1 A12 (m solves), S = A22 - A21 Y (m x m, dense), then for each right-hand side
+//! z = A11^-1 b1, x2 = S^-1 (b2 - A21 z), x1 = z - Y x2. A11 must be non-singular: the plate is
+//! held by its supports or by displacement-driven punches, not only by the force-driven ones.
+//! With m = 0 it is exactly [`SparseLu`].
+
+use crate::error::{Result, StampError};
+use crate::linear_solver::{LinearSolver, SolverTimings, SparseLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use nalgebra::DMatrix;
+
+/// Sparse LU on the leading block and a dense Schur complement for the last `border` unknowns.
+pub struct BorderedLu {
+    inner: SparseLu,
+    border: usize,
+    /// nnz of the full pattern the maps below were built for.
+    pattern_nnz: usize,
+    n0: usize,
+    sym11: Option<SymbolicSparseColMat<usize>>,
+    /// Position in the full value array of every entry of A11, in A11's order.
+    map11: Vec<usize>,
+    vals11: Vec<f64>,
+    /// (row, column k, position) of A12's entries (rows < n0, column n0 + k).
+    a12: Vec<(usize, usize, usize)>,
+    /// (row k, column, position) of A21's entries (row n0 + k, columns < n0).
+    a21: Vec<(usize, usize, usize)>,
+    /// (row k, column l, position) of A22's entries.
+    a22: Vec<(usize, usize, usize)>,
+    /// Y = A11^-1 A12, column-major n0 x m.
+    y: Vec<f64>,
+    /// A21 as a dense m x n0 matrix (row-major) of the last factorisation.
+    a21_dense: Vec<f64>,
+    schur: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+}
+
+impl BorderedLu {
+    /// A solver for matrices whose last `border` rows and columns are the border.
+    pub fn new(border: usize) -> Self {
+        BorderedLu {
+            inner: SparseLu::new(),
+            border,
+            pattern_nnz: usize::MAX,
+            n0: 0,
+            sym11: None,
+            map11: Vec::new(),
+            vals11: Vec::new(),
+            a12: Vec::new(),
+            a21: Vec::new(),
+            a22: Vec::new(),
+            y: Vec::new(),
+            a21_dense: Vec::new(),
+            schur: None,
+        }
+    }
+
+    fn build_maps(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
+        let n = a.ncols();
+        let m = self.border;
+        if m > n || a.nrows() != n {
+            return Err(StampError::LinearSolver(format!("a {}x{n} matrix cannot have a border of {m}", a.nrows())));
+        }
+        let n0 = n - m;
+        let sym = a.symbolic();
+        let (cp, ri) = (sym.col_ptr(), sym.row_idx());
+        let mut col_ptr = Vec::with_capacity(n0 + 1);
+        let mut row_idx = Vec::new();
+        self.map11.clear();
+        self.a12.clear();
+        self.a21.clear();
+        self.a22.clear();
+        col_ptr.push(0);
+        for j in 0..n {
+            for p in cp[j]..cp[j + 1] {
+                let i = ri[p];
+                match (i < n0, j < n0) {
+                    (true, true) => {
+                        row_idx.push(i);
+                        self.map11.push(p);
+                    }
+                    (true, false) => self.a12.push((i, j - n0, p)),
+                    (false, true) => self.a21.push((i - n0, j, p)),
+                    (false, false) => self.a22.push((i - n0, j - n0, p)),
+                }
+            }
+            if j < n0 {
+                col_ptr.push(row_idx.len());
+            }
+        }
+        self.sym11 = Some(SymbolicSparseColMat::new_checked(n0, n0, col_ptr, None, row_idx));
+        self.vals11 = vec![0.0; self.map11.len()];
+        self.n0 = n0;
+        self.pattern_nnz = ri.len();
+        Ok(())
+    }
+}
+
+impl LinearSolver for BorderedLu {
+    fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
+        if self.border == 0 {
+            return self.inner.factorize(a);
+        }
+        if self.pattern_nnz != a.symbolic().row_idx().len() || self.sym11.is_none() {
+            self.build_maps(a)?;
+        }
+        let (n0, m) = (self.n0, self.border);
+        let vals = a.val();
+        for (v, &p) in self.vals11.iter_mut().zip(&self.map11) {
+            *v = vals[p];
+        }
+        let a11 = SparseColMatRef::new(self.sym11.as_ref().unwrap().as_ref(), &self.vals11);
+        self.inner.factorize(a11)?;
+        // Y = A11^-1 A12
+        self.y = vec![0.0; n0 * m];
+        for &(i, k, p) in &self.a12 {
+            self.y[k * n0 + i] += vals[p];
+        }
+        for k in 0..m {
+            self.inner.solve_in_place(&mut self.y[k * n0..(k + 1) * n0])?;
+        }
+        // S = A22 - A21 Y
+        self.a21_dense = vec![0.0; m * n0];
+        for &(k, j, p) in &self.a21 {
+            self.a21_dense[k * n0 + j] += vals[p];
+        }
+        let mut s = DMatrix::<f64>::zeros(m, m);
+        for &(k, l, p) in &self.a22 {
+            s[(k, l)] += vals[p];
+        }
+        for k in 0..m {
+            let row = &self.a21_dense[k * n0..(k + 1) * n0];
+            for l in 0..m {
+                let col = &self.y[l * n0..(l + 1) * n0];
+                s[(k, l)] -= row.iter().zip(col).map(|(a, b)| a * b).sum::<f64>();
+            }
+        }
+        let lu = s.lu();
+        if !lu.is_invertible() {
+            self.schur = None;
+            return Err(StampError::LinearSolver("the Schur complement of the bordered system is singular (a force-driven punch touches nothing?)".into()));
+        }
+        self.schur = Some(lu);
+        Ok(())
+    }
+
+    fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()> {
+        if self.border == 0 {
+            return self.inner.solve_in_place(b);
+        }
+        let (n0, m) = (self.n0, self.border);
+        let Some(schur) = self.schur.as_ref() else {
+            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
+        };
+        let (b1, b2) = b.split_at_mut(n0);
+        self.inner.solve_in_place(b1)?;
+        // x2 = S^-1 (b2 - A21 z)
+        let mut r = nalgebra::DVector::<f64>::zeros(m);
+        for k in 0..m {
+            let row = &self.a21_dense[k * n0..(k + 1) * n0];
+            r[k] = b2[k] - row.iter().zip(b1.iter()).map(|(a, z)| a * z).sum::<f64>();
+        }
+        let x2 = schur.solve(&r).ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
+        for k in 0..m {
+            b2[k] = x2[k];
+            let col = &self.y[k * n0..(k + 1) * n0];
+            for (x, yv) in b1.iter_mut().zip(col) {
+                *x -= yv * x2[k];
+            }
+        }
+        if b.iter().any(|x| !x.is_finite()) {
+            return Err(StampError::LinearSolver("the solution has non-finite entries: the matrix is singular".into()));
+        }
+        Ok(())
+    }
+
+    fn timings(&self) -> SolverTimings {
+        self.inner.timings()
+    }
+}
