@@ -4,7 +4,7 @@
 //!     cargo run --release --example ellipsoid_punch
 
 use nalgebra::{Matrix3, Vector3};
-use stamp::bordered::BorderedLu;
+use stamp::bordered::BorderedSolver;
 use stamp::contact::{automatic_eps_reg, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
@@ -67,7 +67,7 @@ fn main() -> stamp::Result<()> {
     model.augmented_tolerance = Some(1e-6);
 
     let settings = NewtonSettings { max_increment: 0.25, ..NewtonSettings::default() };
-    let mut newton = NewtonRaphson::new(BorderedLu::new(model.num_drives()), settings);
+    let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
     let mut u = vec![0.0; model.num_dofs()];
     let mut zones = Vec::new();
     println!("  load   travel  active  zone along x1  along x2  reaction");

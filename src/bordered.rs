@@ -9,20 +9,23 @@
 //! every candidate contact point: see [`crate::model::Model`]). A sparse LU of the whole matrix
 //! would see a dense row, and its symbolic phase (which bounds the factors by the Cholesky
 //! structure of A^T A) turns the block of every coupled column dense: several times slower than
-//! the nodal system alone. Block elimination keeps the sparse LU on A11 only:
+//! the nodal system alone. Block elimination keeps the sparse solver on A11 only:
 //! Y = A11^-1 A12 (m solves), S = A22 - A21 Y (m x m, dense), then for each right-hand side
 //! z = A11^-1 b1, x2 = S^-1 (b2 - A21 z), x1 = z - Y x2. A11 must be non-singular: the plate is
 //! held by its supports or by displacement-driven punches, not only by the force-driven ones.
-//! With m = 0 it is exactly [`SparseLu`].
+//! With m = 0 it is exactly the inner solver: by default [`LdltGmres`] (the LDL^T of the symmetric
+//! part, GMRES where A11 is not symmetric), or any [`LinearSolver`], e.g. [`crate::linear_solver::SparseLu`].
 
 use crate::error::{Result, StampError};
-use crate::linear_solver::{LinearSolver, SolverTimings, SparseLu};
+use crate::ldlt_gmres::LdltGmres;
+use crate::linear_solver::{LinearSolver, SolverTimings};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use nalgebra::DMatrix;
 
-/// Sparse LU on the leading block and a dense Schur complement for the last `border` unknowns.
-pub struct BorderedLu {
-    inner: SparseLu,
+/// A sparse solver on the leading block and a dense Schur complement for the last `border`
+/// unknowns.
+pub struct BorderedSolver<S: LinearSolver = LdltGmres> {
+    inner: S,
     border: usize,
     /// nnz of the full pattern the maps below were built for.
     pattern_nnz: usize,
@@ -44,11 +47,19 @@ pub struct BorderedLu {
     schur: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
 }
 
-impl BorderedLu {
-    /// A solver for matrices whose last `border` rows and columns are the border.
+impl BorderedSolver<LdltGmres> {
+    /// A solver for matrices whose last `border` rows and columns are the border, with the
+    /// default inner solver.
     pub fn new(border: usize) -> Self {
-        BorderedLu {
-            inner: SparseLu::new(),
+        Self::with_inner(border, LdltGmres::new())
+    }
+}
+
+impl<S: LinearSolver> BorderedSolver<S> {
+    /// The same with a given solver for the leading block.
+    pub fn with_inner(border: usize, inner: S) -> Self {
+        BorderedSolver {
+            inner,
             border,
             pattern_nnz: usize::MAX,
             n0: 0,
@@ -105,7 +116,7 @@ impl BorderedLu {
     }
 }
 
-impl LinearSolver for BorderedLu {
+impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
     fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
         if self.border == 0 {
             return self.inner.factorize(a);

@@ -15,6 +15,8 @@ pub use error::{Result, StampError};
 pub mod dofs;
 pub mod element;
 pub mod linear_solver;
+pub mod gmres;
+pub mod ldlt_gmres;
 pub mod bordered;
 pub mod sparse;
 pub mod assembly;

@@ -106,7 +106,7 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
         lu.factorize(model.matrix()).unwrap();
         lu.solve_in_place(&mut x_lu).unwrap();
         let mut x_b = r.clone();
-        let mut b = stamp::bordered::BorderedLu::new(1);
+        let mut b = stamp::bordered::BorderedSolver::new(1);
         b.factorize(model.matrix()).unwrap();
         b.solve_in_place(&mut x_b).unwrap();
         let norm = x_lu.iter().fold(0.0f64, |m, x| m.max(x.abs()));

@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
 use stamp::dofs::DofMap;
 use stamp::io::{write_vtu, Field};
-use stamp::linear_solver::{LinearSolver, SparseLu};
+use stamp::linear_solver::LinearSolver;
+use stamp::ldlt_gmres::{LdltGmres, LdltGmresStats};
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
@@ -56,6 +57,9 @@ pub struct BenchRun {
     pub assemblies: usize,
     pub factorizations: usize,
     pub threads: usize,
+    /// What the linear solver did: LDL^T factorisations used directly or as GMRES preconditioner,
+    /// GMRES iterations, hand-overs to the LU.
+    pub linear_solver: LdltGmresStats,
     /// Centre deflection of the mid-surface and the total contact force on the whole plate: the
     /// same problem at every size, so these converge with n.
     pub centre_deflection: f64,
@@ -63,7 +67,7 @@ pub struct BenchRun {
 }
 
 /// Build the quarter model on an n x n mesh.
-fn build(n: usize) -> Result<Model<PlateElements>> {
+pub fn build(n: usize) -> Result<Model<PlateElements>> {
     let half = 0.5 * SIDE;
     let mesh = QuadMesh::rectangle(0.0, half, 0.0, half, n, n)?;
     let section = Section::homogeneous(THICKNESS, Isotropic::new(YOUNG, POISSON)?)?;
@@ -111,8 +115,8 @@ pub fn run_one(n: usize) -> Result<BenchRun> {
     }
     let start = Instant::now();
     let mut model = build(n)?;
-    let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, ..NewtonSettings::default() };
-    let mut newton = NewtonRaphson::new(SparseLu::new(), settings);
+    let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, ..NewtonSettings::default() };
+    let mut newton = NewtonRaphson::new(LdltGmres::new(), settings);
     let mut u = vec![0.0; model.num_dofs()];
     let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
 
@@ -149,6 +153,7 @@ pub fn run_one(n: usize) -> Result<BenchRun> {
         assemblies: mt.assemblies,
         factorizations: st.factorizations,
         threads: rayon::current_num_threads(),
+        linear_solver: newton.linear.stats(),
         centre_deflection: 0.5 * (u[2] + u[5]),
         reaction,
     })

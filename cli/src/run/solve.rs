@@ -8,7 +8,7 @@ use super::problem::{PlotAxis, Problem};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use stamp::io::{write_pvd, write_string_atomically, write_vtu};
-use stamp::bordered::BorderedLu;
+use stamp::bordered::BorderedSolver;
 use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
 use stamp::{Result, StampError};
 use std::io::IsTerminal;
@@ -216,7 +216,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
     // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
-    let mut newton = NewtonRaphson::new(BorderedLu::new(model.num_drives()), settings);
+    let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
     newton.on_iteration = progress.callback();
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);

@@ -1,0 +1,70 @@
+//! Issue 5: the fast linear solver (LDL^T of the symmetric part, GMRES on the plate's
+//! non-symmetric tangent) against the sparse LU, on the real matrices of the sphere problem.
+
+mod common;
+use common::sphere::*;
+use stamp::ldlt_gmres::LdltGmres;
+use stamp::linear_solver::{LinearSolver, SparseLu};
+use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
+
+fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
+    let norm = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / norm
+}
+
+/// The tangent of a deformed, contacting plate: not symmetric (b_ab33 = 0), so the solver takes the
+/// preconditioned path, and its solution is the LU's.
+#[test]
+fn plate_tangent_is_solved_like_the_lu() {
+    let p = SphereProblem::new(40.0, 1.0, 12, Support::Clamped);
+    let (_, mut model) = p.build();
+    let mut rng = common::Lcg(7);
+    let u: Vec<f64> = (0..model.num_dofs()).map(|_| 0.05 * (rng.next() - 0.5)).collect();
+    model.evaluate(&u, 0.5, true).unwrap();
+    let b = model.residual().to_vec();
+    let mut lu = SparseLu::new();
+    lu.factorize(model.matrix()).unwrap();
+    let mut x_lu = b.clone();
+    lu.solve_in_place(&mut x_lu).unwrap();
+    let mut fast = LdltGmres::new();
+    fast.factorize(model.matrix()).unwrap();
+    let mut x = b.clone();
+    fast.solve_in_place(&mut x).unwrap();
+    let st = fast.stats();
+    assert_eq!((st.direct, st.preconditioned, st.lu_fallbacks), (0, 1, 0), "{st:?}");
+    assert!(st.gmres_iterations >= 2 && st.gmres_iterations <= 40, "{st:?}");
+    let d = relative_difference(&x_lu, &x);
+    println!("GMRES iterations {}, relative difference from the LU {d:.2e}", st.gmres_iterations);
+    assert!(d < 1e-8, "{d:e}");
+}
+
+/// The whole load path with either solver: the same steps, the same answer.
+#[test]
+fn sphere_problem_is_solved_like_the_lu() {
+    let mut p = SphereProblem::new(40.0, 1.0, 10, Support::SimplySoft);
+    p.depth = 1.5; // bending and membrane action, a contact zone of several nodes
+    let run = |fast: bool| {
+        let (mesh, mut model) = p.build();
+        let mut u = vec![0.0; model.num_dofs()];
+        let (summary, stats) = if fast {
+            let mut newton = NewtonRaphson::new(LdltGmres::new(), p.settings());
+            let s = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
+            (s, Some(newton.linear.stats()))
+        } else {
+            let mut newton = NewtonRaphson::new(SparseLu::new(), p.settings());
+            (newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap(), None)
+        };
+        (summary.steps, p.measure(&mesh, &model, &u), u, stats)
+    };
+    let (steps_lu, r_lu, u_lu, _) = run(false);
+    let (steps, r, u, stats) = run(true);
+    let st = stats.unwrap();
+    println!("LU: {r_lu:?}\nLDL^T + GMRES: {r:?}, {st:?}");
+    assert_eq!(steps, steps_lu);
+    assert_eq!(st.lu_fallbacks, 0, "{st:?}");
+    assert!(st.preconditioned > 0);
+    assert_eq!(r.active, r_lu.active);
+    assert!(r.active >= 3, "{r:?}");
+    assert!((r.reaction / r_lu.reaction - 1.0).abs() < 1e-8, "{} vs {}", r.reaction, r_lu.reaction);
+    assert!(relative_difference(&u_lu, &u) < 1e-8);
+}
