@@ -109,14 +109,14 @@ pub fn peak_rss_bytes() -> u64 {
 
 /// Solve one size in this process and time it. The deformed plate of the last step is written as
 /// a .vtu file into a temporary folder (timed as output) and removed.
-pub fn run_one(n: usize) -> Result<BenchRun> {
+pub fn run_one(n: usize, reuse: bool) -> Result<BenchRun> {
     if n == 0 {
         return Err(StampError::Problem("bench sizes must be positive".into()));
     }
     let start = Instant::now();
     let mut model = build(n)?;
     let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, ..NewtonSettings::default() };
-    let mut newton = NewtonRaphson::new(LdltGmres::new(), settings);
+    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(reuse), settings);
     let mut u = vec![0.0; model.num_dofs()];
     let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
 
@@ -160,12 +160,13 @@ pub fn run_one(n: usize) -> Result<BenchRun> {
 }
 
 /// Run every size in a child process (`<this program> bench --one n`) and collect the results.
-pub fn run_sizes(sizes: &[usize], mut on_run: impl FnMut(&BenchRun)) -> Result<Vec<BenchRun>> {
+pub fn run_sizes(sizes: &[usize], reuse: bool, mut on_run: impl FnMut(&BenchRun)) -> Result<Vec<BenchRun>> {
     let exe = std::env::current_exe().map_err(|e| StampError::io("the stamp program itself", e))?;
     let mut runs = Vec::new();
     for &n in sizes {
         let out = std::process::Command::new(&exe)
             .args(["bench", "--one", &n.to_string()])
+            .args(if reuse { &["--reuse"][..] } else { &[][..] })
             .output()
             .map_err(|e| StampError::io(&exe, e))?;
         if !out.status.success() {
@@ -182,8 +183,8 @@ pub fn run_sizes(sizes: &[usize], mut on_run: impl FnMut(&BenchRun)) -> Result<V
 pub fn header() -> String {
     format!(
         "stamp bench: simply supported square plate (side {SIDE}, h = {THICKNESS}, quarter model) under a sphere (R = {RADIUS}, travel {PUNCH_TRAVEL})\n\
-         {:>5} {:>9} {:>5} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
-        "n", "unknowns", "steps", "newton", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
+         {:>5} {:>9} {:>5} {:>6} {:>7} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
+        "n", "unknowns", "steps", "newton", "factors", "gmres", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
     )
 }
 
@@ -191,11 +192,13 @@ pub fn header() -> String {
 pub fn row(r: &BenchRun) -> String {
     let s = &r.seconds;
     format!(
-        "{:>5} {:>9} {:>5} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
+        "{:>5} {:>9} {:>5} {:>6} {:>7} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
         r.n,
         r.unknowns,
         r.steps,
         r.newton_iterations,
+        r.factorizations,
+        r.linear_solver.gmres_iterations,
         s.assembly,
         s.contact,
         s.symbolic,
@@ -210,22 +213,22 @@ pub fn row(r: &BenchRun) -> String {
 }
 
 /// `stamp bench`: all sizes, as a table or as JSON.
-pub fn bench_command(sizes: &[usize], json: bool) -> Result<()> {
+pub fn bench_command(sizes: &[usize], json: bool, reuse: bool) -> Result<()> {
     if json {
-        let runs = run_sizes(sizes, |_| {})?;
+        let runs = run_sizes(sizes, reuse, |_| {})?;
         let text = serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).map_err(|e| StampError::Problem(e.to_string()))?;
         println!("{text}");
     } else {
         println!("{}", header());
-        run_sizes(sizes, |r| println!("{}", row(r)))?;
-        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve", rayon::current_num_threads());
+        run_sizes(sizes, reuse, |r| println!("{}", row(r)))?;
+        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), gmres: GMRES iterations", rayon::current_num_threads());
     }
     Ok(())
 }
 
 /// `stamp bench --one n`: one size, as one JSON object on stdout.
-pub fn one_command(n: usize) -> Result<()> {
-    let run = run_one(n)?;
+pub fn one_command(n: usize, reuse: bool) -> Result<()> {
+    let run = run_one(n, reuse)?;
     println!("{}", serde_json::to_string(&run).map_err(|e| StampError::Problem(e.to_string()))?);
     Ok(())
 }

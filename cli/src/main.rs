@@ -41,6 +41,10 @@ enum Command {
         /// Print the results as JSON: {"runs": [...]}.
         #[arg(long)]
         json: bool,
+        /// Reuse a factorisation across Newton iterations as GMRES's preconditioner while that is
+        /// cheaper than factorising again (default: factorise every iteration's matrix).
+        #[arg(long)]
+        reuse: bool,
         /// Run one size in this process and print its JSON (used by `stamp bench` for each size).
         #[arg(long, hide = true)]
         one: Option<usize>,
@@ -53,8 +57,8 @@ fn main() -> ExitCode {
         None => stamp_cli::report::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::report::paper_command(json, plot.as_deref()),
         Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
-        Some(Command::Bench { one: Some(n), .. }) => stamp_cli::bench::one_command(n),
-        Some(Command::Bench { sizes, json, one: None }) => stamp_cli::bench::bench_command(&sizes, json),
+        Some(Command::Bench { one: Some(n), reuse, .. }) => stamp_cli::bench::one_command(n, reuse),
+        Some(Command::Bench { sizes, json, reuse, one: None }) => stamp_cli::bench::bench_command(&sizes, json, reuse),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

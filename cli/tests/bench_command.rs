@@ -53,3 +53,26 @@ fn bench_table_lists_each_size_and_rejects_a_zero_size() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("positive"), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+#[test]
+fn bench_with_reuse_gives_the_same_answer_with_fewer_factorisations() {
+    let run = |extra: &[&str]| {
+        let out = stamp().args(["bench", "--sizes", "12", "--json"]).args(extra).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["runs"][0].clone()
+    };
+    let (plain, reuse) = (run(&[]), run(&["--reuse"]));
+    let f = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap();
+    let ls = |r: &serde_json::Value, k: &str| r["linear_solver"][k].as_u64().unwrap();
+    // the plate's tangent is not symmetric: GMRES preconditioned by the LDL^T of its symmetric part
+    assert_eq!(ls(&plain, "lu_fallbacks"), 0, "{plain}");
+    assert_eq!(ls(&plain, "reused"), 0, "{plain}");
+    assert_eq!(ls(&plain, "preconditioned"), plain["factorizations"].as_u64().unwrap(), "{plain}");
+    assert!(ls(&reuse, "reused") > 0, "{reuse}");
+    assert!(reuse["factorizations"].as_u64().unwrap() < plain["factorizations"].as_u64().unwrap(), "{plain}\n{reuse}");
+    assert_eq!(plain["newton_iterations"], reuse["newton_iterations"]);
+    for k in ["centre_deflection", "reaction"] {
+        assert!((f(&plain, k) / f(&reuse, k) - 1.0).abs() < 1e-8, "{k}: {plain}\n{reuse}");
+    }
+}
