@@ -29,8 +29,8 @@
 //! more, the matrix is factorised on the spot and solved again; and once a stale solve has spent
 //! more than half a factorisation in extra iterations, the next matrix is factorised. The
 //! accuracy of every solve stays the same ([`GMRES_TOL`]), so the Newton iterates do too.
-//! Measured with `stamp bench` (README): it saves two thirds of the factorisations for 40-75 %
-//! more GMRES iterations, 8 % of the time at 240 800 unknowns, nothing at 60 400 and a little
+//! Measured with `stamp bench` (README): it saves two thirds of the factorisations for
+//! more GMRES iterations (17-75 %), 8 % of the time at 240 800 unknowns, nothing at 60 400 and a little
 //! loss below; hence off by default.
 
 use crate::error::{Result, StampError};
