@@ -3,9 +3,9 @@
 //!
 //! Why: the unsymmetric sparse LU orders its columns by COLAMD, which bounds the factors by the
 //! structure of A^T A; on a 2D plate mesh its factors are about 10 times larger than the Cholesky
-//! factor of the same pattern under AMD, and its factorisation several times slower (measured by
-//! `stamp bench` and `examples`-free numbers in the README: at 60 400 unknowns 2.1 s and 1.3 GiB
-//! for the LU against 0.4 s and 0.1 GiB for LDL^T). The plate's tangent is not symmetric only
+//! factor of the same pattern under AMD, and its factorisation several times slower (measured at
+//! 60 400 unknowns, README "Speed": 2.1 s and a 1.4 GiB process for the LU against 0.32-0.45 s
+//! and 0.4 GiB for the LDL^T). The plate's tangent is not symmetric only
 //! because of the paper's b_ab33 = 0 (the thickness stress depends on the in-plane strains, not
 //! the converse; SPEC section 2): its symmetric part S = (A + A^T) / 2 is an excellent
 //! preconditioner, GMRES on S^-1 converging by a decade every two iterations. The framework does
