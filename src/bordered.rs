@@ -132,7 +132,8 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         let a11 = SparseColMatRef::new(self.sym11.as_ref().unwrap().as_ref(), &self.vals11);
         self.inner.factorize(a11)?;
         // Y = A11^-1 A12
-        self.y = vec![0.0; n0 * m];
+        self.y.clear();
+        self.y.resize(n0 * m, 0.0);
         for &(i, k, p) in &self.a12 {
             self.y[k * n0 + i] += vals[p];
         }
@@ -140,7 +141,8 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
             self.inner.solve_in_place(&mut self.y[k * n0..(k + 1) * n0])?;
         }
         // S = A22 - A21 Y
-        self.a21_dense = vec![0.0; m * n0];
+        self.a21_dense.clear();
+        self.a21_dense.resize(m * n0, 0.0);
         for &(k, j, p) in &self.a21 {
             self.a21_dense[k * n0 + j] += vals[p];
         }

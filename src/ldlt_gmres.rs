@@ -35,7 +35,7 @@
 
 use crate::error::{Result, StampError};
 use crate::gmres::{Gmres, GmresReport};
-use crate::linear_solver::{LinearSolver, SolverTimings, SparseLu, PARALLEL_MIN_ROWS};
+use crate::linear_solver::{parallelism_for, LinearSolver, SolverTimings, SparseLu};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymmetricOrdering};
@@ -176,10 +176,6 @@ impl LdltGmres {
         self.stats
     }
 
-    fn effective_par(&self, n: usize) -> Par {
-        if n < PARALLEL_MIN_ROWS { Par::Seq } else { self.par }
-    }
-
     /// Ordering, elimination structure and workspaces for a new pattern.
     fn analyse(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
         let t = Instant::now();
@@ -221,7 +217,7 @@ impl LdltGmres {
     /// The LDL^T of the symmetric values; false on a zero pivot or a non-finite factor.
     fn factorize_ldlt(&mut self) -> bool {
         let n = self.col_ptr.len() - 1;
-        let par = self.effective_par(n);
+        let par = parallelism_for(n, self.par);
         let (Some(sym), Some(buffer)) = (self.symbolic.as_ref(), self.buffer.as_mut()) else { return false };
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         let s = SparseColMatRef::new(pattern, &self.symmetric_values);
@@ -237,7 +233,7 @@ impl LdltGmres {
 
     /// The direct solve with iterative refinement; returns the backward error reached.
     fn direct_solve(&mut self, b: &mut [f64]) -> f64 {
-        let par = self.effective_par(b.len());
+        let par = parallelism_for(b.len(), self.par);
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
         Self::ldlt_solve(sym, &self.factor, buffer, par, b);
         let mut error = backward_error(&self.col_ptr, &self.row_idx, &self.values, self.norm_inf, &self.rhs, b, &mut self.r);
@@ -257,7 +253,7 @@ impl LdltGmres {
 
     /// GMRES on A preconditioned by the LDL^T of S.
     fn preconditioned_solve(&mut self, b: &mut [f64], max_iterations: usize) -> GmresReport {
-        let par = self.effective_par(b.len());
+        let par = parallelism_for(b.len(), self.par);
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
         let (col_ptr, row_idx, values, factor) = (&self.col_ptr, &self.row_idx, &self.values, &self.factor);
         // initial guess S^-1 b

@@ -23,6 +23,12 @@ pub struct SolverTimings {
 /// Matrices with fewer rows are factorised on one thread.
 pub const PARALLEL_MIN_ROWS: usize = 20_000;
 
+/// The parallelism to use for a matrix of `rows` rows given the solver's setting `par`: sequential
+/// below [`PARALLEL_MIN_ROWS`], where waking threads costs more than the factorisation.
+pub fn parallelism_for(rows: usize, par: Par) -> Par {
+    if rows < PARALLEL_MIN_ROWS { Par::Seq } else { par }
+}
+
 /// Factorise a sparse square matrix and solve with it.
 pub trait LinearSolver: Send {
     /// Factorise `a`. Implementations may reuse anything computed for an earlier matrix with the same
@@ -65,12 +71,6 @@ impl SparseLu {
         }
     }
 
-    /// The parallelism used for a matrix of n rows: sequential below [`PARALLEL_MIN_ROWS`], where
-    /// waking threads costs more than the factorisation.
-    fn effective_par(&self, n: usize) -> Par {
-        if n < PARALLEL_MIN_ROWS { Par::Seq } else { self.par }
-    }
-
     /// Use a given parallelism for the factorisation and solves.
     pub fn with_parallelism(par: Par) -> Self {
         SparseLu { par, ..Self::new() }
@@ -92,7 +92,7 @@ impl LinearSolver for SparseLu {
             self.timings.symbolic += t.elapsed().as_secs_f64();
         }
         let t = Instant::now();
-        let par = self.effective_par(a.nrows());
+        let par = parallelism_for(a.nrows(), self.par);
         let sym = self.symbolic.as_ref().unwrap();
         let stack = MemStack::new(self.buffer.as_mut().unwrap());
         self.factored = false;
@@ -113,7 +113,7 @@ impl LinearSolver for SparseLu {
         let lu = LuRef::new_unchecked(sym, &self.numeric);
         let n = b.len();
         let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
-        let par = self.effective_par(n);
+        let par = parallelism_for(n, self.par);
         let stack = MemStack::new(self.buffer.as_mut().unwrap());
         lu.solve_in_place_with_conj(Conj::No, rhs, par, stack);
         self.timings.solve += t.elapsed().as_secs_f64();

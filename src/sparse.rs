@@ -233,14 +233,4 @@ impl SparsePattern {
     pub fn rank(&self, dof: usize) -> u32 {
         self.rank[dof] as u32
     }
-
-    /// Slot of the diagonal-block entry (row dof, column dof) at one node, for contributions that
-    /// couple only the dofs of a single node (nodal contact). `None` when either dof is prescribed.
-    pub fn nodal_slot(&self, dofs: &DofMap, row_dof: usize, col_dof: usize) -> Option<usize> {
-        let ce = dofs.equation(col_dof)?;
-        let re = dofs.equation(row_dof)?;
-        let col = self.symbolic.col_ptr()[ce]..self.symbolic.col_ptr()[ce + 1];
-        let rows = &self.symbolic.row_idx()[col.clone()];
-        rows.binary_search(&re).ok().map(|p| col.start + p)
-    }
 }

@@ -67,7 +67,7 @@ pub struct BenchRun {
 }
 
 /// Build the quarter model on an n x n mesh.
-pub fn build(n: usize) -> Result<Model<PlateElements>> {
+fn build(n: usize) -> Result<Model<PlateElements>> {
     let half = 0.5 * SIDE;
     let mesh = QuadMesh::rectangle(0.0, half, 0.0, half, n, n)?;
     let section = Section::homogeneous(THICKNESS, Isotropic::new(YOUNG, POISSON)?)?;
