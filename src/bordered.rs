@@ -167,15 +167,21 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
     }
 
     fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()> {
+        self.solve_in_place_to(b, 0.0)
+    }
+
+    /// The inner solve of the right-hand side may be inexact (`rtol`); the columns Y of the
+    /// factorisation are always solved to full accuracy.
+    fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
         if self.border == 0 {
-            return self.inner.solve_in_place(b);
+            return self.inner.solve_in_place_to(b, rtol);
         }
         let (n0, m) = (self.n0, self.border);
         let Some(schur) = self.schur.as_ref() else {
             return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
         };
         let (b1, b2) = b.split_at_mut(n0);
-        self.inner.solve_in_place(b1)?;
+        self.inner.solve_in_place_to(b1, rtol)?;
         // x2 = S^-1 (b2 - A21 z)
         let mut r = nalgebra::DVector::<f64>::zeros(m);
         for k in 0..m {

@@ -210,7 +210,8 @@ impl ContactPair {
     /// active points, G and H the gradient and Hessian of Psi with respect to the point's
     /// displacement (and to s for a force-driven punch, whose equation R_s = sum w lambda dPsi/ds
     /// - t F is added into `force[drive.dof]`). Returns the number of points whose active state
-    /// changed.
+    /// changed against the set of the last evaluation with a tangent (only such an evaluation
+    /// records the new set).
     pub fn evaluate(&mut self, u: &[f64], t: f64, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>) -> usize {
         let d = Vector3::from(self.punch_displacement(u, t));
         let drive = self.drive;
@@ -253,14 +254,18 @@ impl ContactPair {
             }
             let active = if self.hold_active_set {
                 // the paper's trial and error: the set stays fixed while Newton converges on it
-                if with_tangent && wanted != self.last_active[k] && !self.frozen[k] {
+                if wanted != self.last_active[k] && !self.frozen[k] {
                     changes += 1;
                 }
                 self.last_active[k]
             } else {
-                if with_tangent && wanted != self.last_active[k] && !self.frozen[k] {
+                // a residual-only evaluation (a line-search trial) reports the changes against
+                // the set of the last tangent but records nothing: the trial may be discarded
+                if wanted != self.last_active[k] && !self.frozen[k] {
                     changes += 1;
-                    record_flip(&mut self.flips[k], &mut self.frozen[k], self.max_flips);
+                    if with_tangent {
+                        record_flip(&mut self.flips[k], &mut self.frozen[k], self.max_flips);
+                    }
                 }
                 if with_tangent {
                     self.last_active[k] = wanted;

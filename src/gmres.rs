@@ -56,13 +56,15 @@ impl Gmres {
     }
 
     /// Solve A x = b, x holding the initial guess on entry, until
-    /// |b - A x| <= tol (a_norm |x| + |b|) or `max_iterations` products. `apply(y, out)`: out = A y; `precondition(z)`: z = M^-1 z in place
+    /// |b - A x| <= tol (a_norm |x| + |b|), or |b - A x| <= rtol |b| (an inexact solve, say for an
+    /// inexact Newton method: 0 for none), or `max_iterations` products. `apply(y, out)`: out = A y; `precondition(z)`: z = M^-1 z in place
     /// (errors propagate).
     pub fn solve<E>(
         &mut self,
         b: &[f64],
         x: &mut [f64],
         tol: f64,
+        rtol: f64,
         a_norm: f64,
         max_iterations: usize,
         apply: &mut dyn FnMut(&[f64], &mut [f64]),
@@ -90,8 +92,11 @@ impl Gmres {
             let beta = dot(&self.r, &self.r).sqrt();
             let scale = a_norm * dot(x, x).sqrt() + b_norm;
             let error = beta / scale;
-            if error <= tol || iterations >= max_iterations || !error.is_finite() {
-                return Ok(GmresReport { iterations, backward_error: error, converged: error <= tol });
+            // the residual this solve must reach
+            let target = (tol * scale).max(rtol * b_norm);
+            let converged = beta <= target;
+            if converged || iterations >= max_iterations || !error.is_finite() {
+                return Ok(GmresReport { iterations, backward_error: error, converged });
             }
             for (v, r) in self.basis[0].iter_mut().zip(&self.r) {
                 *v = r / beta;
@@ -135,7 +140,7 @@ impl Gmres {
                 self.g[k + 1] = -s * self.g[k];
                 self.g[k] *= c;
                 k += 1;
-                if self.g[k].abs() <= 0.5 * tol * scale || norm == 0.0 {
+                if self.g[k].abs() <= 0.5 * target || norm == 0.0 {
                     break;
                 }
             }
@@ -182,7 +187,7 @@ mod tests {
         let mut x = vec![0.0; n];
         let mut g = Gmres::new(10);
         let report = g
-            .solve(&b, &mut x, 1e-13, 0.0, 500, &mut |x, y| apply(x, y), &mut |z: &mut [f64]| -> Result<(), ()> {
+            .solve(&b, &mut x, 1e-13, 0.0, 0.0, 500, &mut |x, y| apply(x, y), &mut |z: &mut [f64]| -> Result<(), ()> {
                 z.iter_mut().for_each(|v| *v /= 4.0);
                 Ok(())
             })
@@ -192,6 +197,33 @@ mod tests {
         assert!(err < 1e-11, "error {err}");
         // restarted: more than one cycle of 10 was needed
         assert!(report.iterations > 10, "{report:?}");
+    }
+
+    /// An inexact solve stops at the relative residual asked for, in fewer iterations.
+    #[test]
+    fn stops_at_a_relative_residual() {
+        let n = 200;
+        let apply = |x: &[f64], y: &mut [f64]| {
+            for i in 0..n {
+                y[i] = 4.0 * x[i] + if i > 0 { -1.5 * x[i - 1] } else { 0.0 } + if i + 1 < n { -0.5 * x[i + 1] } else { 0.0 };
+            }
+        };
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+        let mut solve = |rtol: f64| {
+            let mut x = vec![0.0; n];
+            let report = Gmres::new(50)
+                .solve(&b, &mut x, 1e-14, rtol, 0.0, 500, &mut |x, y| apply(x, y), &mut |_: &mut [f64]| -> Result<(), ()> { Ok(()) })
+                .unwrap();
+            let mut r = vec![0.0; n];
+            apply(&x, &mut r);
+            let res = r.iter().zip(&b).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt() / b.iter().map(|v| v * v).sum::<f64>().sqrt();
+            (report, res)
+        };
+        let (loose, res_loose) = solve(1e-3);
+        let (tight, res_tight) = solve(0.0);
+        assert!(loose.converged && res_loose <= 1e-3 && res_loose > 1e-12, "{loose:?} {res_loose}");
+        assert!(tight.converged && res_tight <= 1e-13, "{tight:?} {res_tight}");
+        assert!(loose.iterations < tight.iterations / 2, "{loose:?} {tight:?}");
     }
 
     #[test]
@@ -206,7 +238,7 @@ mod tests {
         };
         let b = vec![1.0, 0.0, 1.0, 0.0];
         let mut x = vec![0.0; n];
-        let report = Gmres::new(1).solve(&b, &mut x, 1e-12, 0.0, 20, &mut |x, y| apply(x, y), &mut |_: &mut [f64]| -> Result<(), ()> { Ok(()) }).unwrap();
+        let report = Gmres::new(1).solve(&b, &mut x, 1e-12, 0.0, 0.0, 20, &mut |x, y| apply(x, y), &mut |_: &mut [f64]| -> Result<(), ()> { Ok(()) }).unwrap();
         assert!(!report.converged && report.backward_error > 0.5, "{report:?}");
     }
 }

@@ -116,6 +116,8 @@ pub struct LdltGmres {
     par: Par,
     timings: SolverTimings,
     stats: LdltGmresStats,
+    /// Relative residual at which the current solve may stop (0: to [`GMRES_TOL`] only).
+    rtol: f64,
     /// Workspaces of a solve.
     rhs: Vec<f64>,
     r: Vec<f64>,
@@ -155,6 +157,7 @@ impl LdltGmres {
             par: faer::get_global_parallelism(),
             timings: SolverTimings::default(),
             stats: LdltGmresStats::default(),
+            rtol: 0.0,
             rhs: Vec::new(),
             r: Vec::new(),
         }
@@ -263,6 +266,7 @@ impl LdltGmres {
             &self.rhs,
             b,
             GMRES_TOL,
+            self.rtol,
             self.norm_inf,
             max_iterations,
             &mut |x, y| multiply(col_ptr, row_idx, values, x, y),
@@ -438,6 +442,13 @@ impl LinearSolver for LdltGmres {
             return self.lu.as_mut().unwrap().solve_in_place(b);
         }
         Ok(())
+    }
+
+    fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
+        self.rtol = rtol.max(0.0);
+        let result = self.solve_in_place(b);
+        self.rtol = 0.0;
+        result
     }
 
     fn timings(&self) -> SolverTimings {

@@ -36,6 +36,13 @@ pub trait LinearSolver: Send {
     fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()>;
     /// Solve A x = b in place with the last factorisation.
     fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()>;
+    /// Solve A x = b in place to a relative residual |b - A x| <= rtol |b| at least: an iterative
+    /// solver may stop there (an inexact Newton method needs no more), a direct one solves as
+    /// [`LinearSolver::solve_in_place`] does (the default).
+    fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
+        let _ = rtol;
+        self.solve_in_place(b)
+    }
     /// Time spent so far.
     fn timings(&self) -> SolverTimings;
 }

@@ -93,7 +93,23 @@ pub struct NewtonSettings {
     /// u_n + (t - t_n)/(t_n - t_{n-1}) (u_n - u_{n-1}), instead of u_n: the body follows a moving
     /// punch instead of being overrun by it, which saves most of the iterations of a step.
     pub extrapolate: bool,
+    /// Largest forcing term of the inexact Newton method: the linear solve of an iteration may
+    /// leave a relative residual min(forcing, |R| / force scale) (an iterative linear solver
+    /// stops there; a direct one solves exactly). 0: every solve to full accuracy.
+    pub forcing: f64,
+    /// From this iteration on, a step whose active set changed at each of the last
+    /// [`CYCLING_WINDOW`] iterations is given up and cut back (0: never): an active set that
+    /// swings wholesale at every iteration (first contact of a fine mesh under a large increment)
+    /// rarely settles, and a smaller increment converges in fewer iterations than it would waste.
+    pub cycling_after: usize,
+    /// Once |R| <= chord_tol * force scale (with an unchanged active set), correct with the
+    /// factorisation of the last iterate instead of a new tangent (a chord step); 0: never.
+    pub chord_tol: f64,
 }
+
+/// Iterations in a row with a changing active set that count as cycling.
+pub const CYCLING_WINDOW: usize = 6;
+
 
 impl Default for NewtonSettings {
     fn default() -> Self {
@@ -114,6 +130,9 @@ impl Default for NewtonSettings {
             max_cutbacks: 12,
             max_restarts: 20,
             extrapolate: true,
+            forcing: 1e-6,
+            cycling_after: 10,
+            chord_tol: 1e-6,
         }
     }
 }
@@ -185,12 +204,27 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         let mut last_energy = f64::INFINITY;
         let debug = std::env::var_os("STAMP_DEBUG").is_some();
         let mut scaled = if s.line_search_steps > 0 { vec![0.0; du.len()] } else { Vec::new() };
+        let mut trial = if s.line_search_steps > 0 { u.to_vec() } else { Vec::new() };
+        // the residual at u found by the line search (its tangent not yet assembled)
+        let mut known: Option<Evaluation> = None;
+        // the linear solver holds the factorisation of an earlier iterate of this solve
+        let mut factored = false;
+        // iterations in a row, up to this one, whose active set changed
+        let mut changing = 0;
+        // the last correction was a chord step; chord steps taken (for the debug output)
+        let mut last_chord = false;
+        let mut chords = 0usize;
         for it in 0..=s.max_iterations {
-            let ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), f64::NAN, 0.0))?;
+            let (ev, with_tangent) = match known.take() {
+                Some(ev) => (ev, false),
+                None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), f64::NAN, 0.0))?, true),
+            };
             let tol = s.rel_tol * ev.force_scale + s.abs_tol;
             history.push(ev.residual_norm);
+            // a chord step may follow a Newton step, or a chord step that reduced |R| a hundredfold
+            let chord_allowed = !last_chord || (history.len() > 1 && ev.residual_norm <= 1e-2 * history[history.len() - 2]);
             if debug {
-                eprintln!("t={t:.6e} it={it} |R|={:.3e} scale={:.3e} changes={} energy={:.3e}/{:.3e}", ev.residual_norm, ev.force_scale, ev.active_changes, last_energy, first_energy);
+                eprintln!("t={t:.6e} it={it} |R|={:.3e} scale={:.3e} changes={} energy={:.3e}/{:.3e} chords={chords}", ev.residual_norm, ev.force_scale, ev.active_changes, last_energy, first_energy);
             }
             if let Some(cb) = self.on_iteration.as_mut() {
                 cb(it, ev.residual_norm, ev.force_scale);
@@ -226,12 +260,17 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                     return Ok(history);
                 }
                 if p.update_active_set() > 0 && it < s.max_iterations {
-                    // converged on the old set: re-solve with the new one
+                    // converged on the old set: re-solve with the new one (whose tangent is new)
+                    factored = false;
                     last_energy = f64::INFINITY;
                     first_energy = f64::NAN;
                     last_correction = f64::INFINITY;
                     continue;
                 }
+            }
+            changing = if ev.active_changes > 0 { changing + 1 } else { 0 };
+            if s.cycling_after > 0 && it >= s.cycling_after && changing >= CYCLING_WINDOW {
+                return Err((format!("the active set changed at each of the last {changing} iterations (cycling)"), ev.residual_norm, tol));
             }
             if it == s.max_iterations {
                 let why = if ev.active_changes > 0 { " (the active set kept changing)" } else { "" };
@@ -240,9 +279,35 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             if ev.residual_norm > 1e30 * first {
                 return Err(("the residual diverged".into(), ev.residual_norm, tol));
             }
+            // Near the solution the tangent hardly changes from one iterate to the next: a chord
+            // step (modified Newton) with the factorisation of the last iterate contracts |R| as
+            // well as a Newton step would, for one solve instead of a tangent and a
+            // factorisation; it aims at a tenth of the tolerance. A chord step that does not
+            // reduce |R| a hundredfold is followed by a Newton step.
+            let chord = factored
+                && chord_allowed
+                && ev.active_changes == 0
+                && ev.residual_norm <= s.chord_tol * ev.force_scale
+                && ev.residual_norm > 0.0;
             du.copy_from_slice(p.residual());
-            self.linear.factorize(p.matrix()).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
-            self.linear.solve_in_place(&mut du).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+            if chord {
+                let rtol = (0.1 * tol / ev.residual_norm).clamp(1e-14, 0.1);
+                self.linear.solve_in_place_to(&mut du, rtol).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+                chords += 1;
+            } else {
+                if !with_tangent {
+                    p.evaluate(u, t, true).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+                    du.copy_from_slice(p.residual());
+                }
+                self.linear.factorize(p.matrix()).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+                factored = true;
+                // inexact Newton (Dembo, Eisenstat & Steihaug 1982; Eisenstat & Walker 1996): a
+                // linear residual of eta |R|, eta <= |R| / force scale, keeps the convergence
+                // quadratic, and an iterative linear solver stops early while |R| is large
+                let forcing = s.forcing.min(ev.residual_norm / ev.force_scale.max(f64::MIN_POSITIVE));
+                self.linear.solve_in_place_to(&mut du, forcing).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+            }
+            last_chord = chord;
             for x in du.iter_mut() {
                 *x = -*x;
             }
@@ -255,15 +320,16 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             // into the punch (and the active set from swinging wholesale)
             let r0 = ev.residual_norm;
             let mut alpha = 1.0;
-            let mut trial = if s.line_search_steps > 0 { u.to_vec() } else { Vec::new() };
             for _ in 0..s.line_search_steps {
                 trial.copy_from_slice(u);
                 for (d, x) in scaled.iter_mut().zip(&du) {
                     *d = alpha * x;
                 }
                 p.add_increment(&mut trial, &scaled);
-                let r = p.evaluate(&trial, t, false).map(|e| e.residual_norm).unwrap_or(f64::INFINITY);
-                if r.is_finite() && r <= (1.0 - 1e-4 * alpha) * r0 {
+                let e = p.evaluate(&trial, t, false).ok().filter(|e| e.residual_norm.is_finite());
+                if let Some(e) = e.filter(|e| e.residual_norm <= (1.0 - 1e-4 * alpha) * r0) {
+                    // accepted: the next iterate is this trial, whose residual is known
+                    known = Some(e);
                     break;
                 }
                 alpha *= 0.5;
