@@ -115,8 +115,7 @@ pub fn run_one(n: usize, reuse: bool) -> Result<BenchRun> {
     }
     let start = Instant::now();
     let mut model = build(n)?;
-    let mut settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, ..NewtonSettings::default() };
-    if let Some(f) = std::env::var("STAMP_FORCING").ok().and_then(|v| v.parse().ok()) { settings.forcing = f; }
+    let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, ..NewtonSettings::default() };
     let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(reuse), settings);
     let mut u = vec![0.0; model.num_dofs()];
     let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
