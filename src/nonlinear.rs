@@ -98,9 +98,13 @@ pub struct NewtonSettings {
     /// stops there; a direct one solves exactly). 0: every solve to full accuracy.
     pub forcing: f64,
     /// From this iteration on, a step whose active set changed at each of the last
-    /// [`CYCLING_WINDOW`] iterations is given up and cut back (0: never): an active set that
-    /// swings wholesale at every iteration (first contact of a fine mesh under a large increment)
-    /// rarely settles, and a smaller increment converges in fewer iterations than it would waste.
+    /// [`CYCLING_WINDOW`] iterations while |R| made no progress (the least |R| of the window's
+    /// second half above half that of its first half) is given up and cut back (0: never, the
+    /// default). For an active set that swings wholesale at every iteration (first contact of a
+    /// fine mesh under a large increment: `stamp bench` at 961 600 unknowns, a thousand points
+    /// in and out at each iteration) a smaller increment is cheaper than 25 iterations. Off by
+    /// default because it costs more than it saves on paths whose active set settles late:
+    /// measured on `stamp paper`, 2146 Newton iterations in all without, 3006 with 8.
     pub cycling_after: usize,
     /// Once |R| <= chord_tol * force scale (with an unchanged active set), correct with the
     /// factorisation of the last iterate instead of a new tangent (a chord step); 0: never.
@@ -131,7 +135,7 @@ impl Default for NewtonSettings {
             max_restarts: 20,
             extrapolate: true,
             forcing: 1e-6,
-            cycling_after: 10,
+            cycling_after: 0,
             chord_tol: 1e-6,
         }
     }
@@ -270,7 +274,14 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             }
             changing = if ev.active_changes > 0 { changing + 1 } else { 0 };
             if s.cycling_after > 0 && it >= s.cycling_after && changing >= CYCLING_WINDOW {
-                return Err((format!("the active set changed at each of the last {changing} iterations (cycling)"), ev.residual_norm, tol));
+                // cycling without progress: the smallest |R| of the window's second half is no
+                // better than half that of its first half
+                let window = &history[history.len() - CYCLING_WINDOW..];
+                let (older, newer) = window.split_at(CYCLING_WINDOW / 2);
+                let least = |h: &[f64]| h.iter().cloned().fold(f64::INFINITY, f64::min);
+                if least(newer) > 0.5 * least(older) {
+                    return Err((format!("the active set changed at each of the last {changing} iterations without reducing |R| (cycling)"), ev.residual_norm, tol));
+                }
             }
             if it == s.max_iterations {
                 let why = if ev.active_changes > 0 { " (the active set kept changing)" } else { "" };
