@@ -90,6 +90,9 @@ pub struct LdltGmres {
     row_idx: Vec<usize>,
     values: Vec<f64>,
     symmetric_values: Vec<f64>,
+    /// The values of A^T in A's (symmetric) pattern, i.e. A by rows: for the products A x of
+    /// GMRES, computed row by row in parallel.
+    row_values: Vec<f64>,
     /// Position of a_ji for every stored a_ij (None: the pattern is not symmetric).
     transpose: Option<Vec<usize>>,
     /// max_i sum_j |a_ij|.
@@ -139,6 +142,7 @@ impl LdltGmres {
             row_idx: Vec::new(),
             values: Vec::new(),
             symmetric_values: Vec::new(),
+            row_values: Vec::new(),
             transpose: None,
             norm_inf: 0.0,
             buffer: None,
@@ -186,6 +190,7 @@ impl LdltGmres {
         self.row_idx = a.symbolic().row_idx().to_vec();
         self.values = vec![0.0; self.row_idx.len()];
         self.symmetric_values = vec![0.0; self.row_idx.len()];
+        self.row_values = vec![0.0; self.row_idx.len()];
         self.transpose = transpose_positions(&self.col_ptr, &self.row_idx);
         self.symbolic = None;
         self.factor_valid = false;
@@ -239,7 +244,8 @@ impl LdltGmres {
         let par = parallelism_for(b.len(), self.par);
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
         Self::ldlt_solve(sym, &self.factor, buffer, par, b);
-        let mut error = backward_error(&self.col_ptr, &self.row_idx, &self.values, self.norm_inf, &self.rhs, b, &mut self.r);
+        let parallel = matches!(par, Par::Rayon(_));
+        let mut error = backward_error(&self.col_ptr, &self.row_idx, &self.row_values, parallel, self.norm_inf, &self.rhs, b, &mut self.r);
         for _ in 0..2 {
             if !(error > ACCEPT) || !error.is_finite() {
                 break;
@@ -249,7 +255,7 @@ impl LdltGmres {
                 *x += d;
             }
             self.stats.refinements += 1;
-            error = backward_error(&self.col_ptr, &self.row_idx, &self.values, self.norm_inf, &self.rhs, b, &mut self.r);
+            error = backward_error(&self.col_ptr, &self.row_idx, &self.row_values, parallel, self.norm_inf, &self.rhs, b, &mut self.r);
         }
         error
     }
@@ -258,7 +264,8 @@ impl LdltGmres {
     fn preconditioned_solve(&mut self, b: &mut [f64], max_iterations: usize) -> GmresReport {
         let par = parallelism_for(b.len(), self.par);
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
-        let (col_ptr, row_idx, values, factor) = (&self.col_ptr, &self.row_idx, &self.values, &self.factor);
+        let (col_ptr, row_idx, row_values, factor) = (&self.col_ptr, &self.row_idx, &self.row_values, &self.factor);
+        let parallel = matches!(par, Par::Rayon(_));
         // initial guess S^-1 b
         b.copy_from_slice(&self.rhs);
         Self::ldlt_solve(sym, factor, buffer, par, b);
@@ -269,7 +276,7 @@ impl LdltGmres {
             self.rtol,
             self.norm_inf,
             max_iterations,
-            &mut |x, y| multiply(col_ptr, row_idx, values, x, y),
+            &mut |x, y| multiply_rows(col_ptr, row_idx, row_values, x, y, parallel),
             &mut |z: &mut [f64]| -> std::result::Result<(), ()> {
                 Self::ldlt_solve(sym, factor, buffer, par, z);
                 Ok(())
@@ -306,7 +313,29 @@ impl LdltGmres {
     }
 }
 
+/// Rows per task of the parallel product.
+const ROWS_PER_TASK: usize = 4096;
+
+/// y = A x computed by rows, for a matrix of symmetric pattern: `row_values[k]` is
+/// a_{c, row_idx[k]} for the k-th stored entry of column c (A^T stored in A's pattern), so that
+/// y_c = sum_k row_values[k] x[row_idx[k]] over column c. Rows in parallel when `parallel`.
+fn multiply_rows(col_ptr: &[usize], row_idx: &[usize], row_values: &[f64], x: &[f64], y: &mut [f64], parallel: bool) {
+    let rows = |first: usize, out: &mut [f64]| {
+        for (i, yi) in out.iter_mut().enumerate() {
+            let c = first + i;
+            *yi = (col_ptr[c]..col_ptr[c + 1]).map(|k| row_values[k] * x[row_idx[k]]).sum();
+        }
+    };
+    if parallel {
+        use rayon::prelude::*;
+        y.par_chunks_mut(ROWS_PER_TASK).enumerate().for_each(|(chunk, out)| rows(chunk * ROWS_PER_TASK, out));
+    } else {
+        rows(0, y);
+    }
+}
+
 /// y = A x for A in compressed columns.
+#[cfg(test)]
 fn multiply(col_ptr: &[usize], row_idx: &[usize], values: &[f64], x: &[f64], y: &mut [f64]) {
     y.iter_mut().for_each(|v| *v = 0.0);
     for (j, &xj) in x.iter().enumerate() {
@@ -316,9 +345,11 @@ fn multiply(col_ptr: &[usize], row_idx: &[usize], values: &[f64], x: &[f64], y: 
     }
 }
 
-/// r = b - A x; returns |r| / (|A| |x| + |b|) in infinity norms.
-fn backward_error(col_ptr: &[usize], row_idx: &[usize], values: &[f64], norm_inf: f64, b: &[f64], x: &[f64], r: &mut [f64]) -> f64 {
-    multiply(col_ptr, row_idx, values, x, r);
+/// r = b - A x (A by rows, see [`multiply_rows`]); returns |r| / (|A| |x| + |b|) in infinity
+/// norms.
+#[allow(clippy::too_many_arguments)]
+fn backward_error(col_ptr: &[usize], row_idx: &[usize], row_values: &[f64], parallel: bool, norm_inf: f64, b: &[f64], x: &[f64], r: &mut [f64]) -> f64 {
+    multiply_rows(col_ptr, row_idx, row_values, x, r, parallel);
     for (ri, bi) in r.iter_mut().zip(b) {
         *ri = bi - *ri;
     }
@@ -371,9 +402,10 @@ impl LinearSolver for LdltGmres {
             return Ok(());
         };
         let mut worst = 0.0f64;
-        for ((s, &v), &k) in self.symmetric_values.iter_mut().zip(&self.values).zip(tr) {
+        for (((s, t), &v), &k) in self.symmetric_values.iter_mut().zip(self.row_values.iter_mut()).zip(&self.values).zip(tr) {
             worst = worst.max((v - self.values[k]).abs());
             *s = 0.5 * (v + self.values[k]);
+            *t = self.values[k];
         }
         let size = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         self.symmetric = worst <= SYMMETRY_TOL * size;
@@ -487,6 +519,26 @@ mod tests {
             }
         }
         matrix(n, &e)
+    }
+
+    /// The row-wise (parallel) product equals the column-wise one on a non-symmetric matrix of
+    /// symmetric pattern spanning several row chunks.
+    #[test]
+    fn row_wise_product_matches_column_wise() {
+        let n = 3 * ROWS_PER_TASK + 17;
+        let a = tridiagonal(n, 0.3, 0.5);
+        let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+        let tr = transpose_positions(cp, ri).unwrap();
+        let rows: Vec<f64> = tr.iter().map(|&k| v[k]).collect();
+        let x: Vec<f64> = (0..n).map(|i| (0.7 * i as f64).sin()).collect();
+        let mut expected = vec![0.0; n];
+        multiply(cp, ri, v, &x, &mut expected);
+        for parallel in [false, true] {
+            let mut y = vec![f64::NAN; n];
+            multiply_rows(cp, ri, &rows, &x, &mut y, parallel);
+            let err = y.iter().zip(&expected).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(err <= 1e-14, "parallel {parallel}: {err:e}");
+        }
     }
 
     fn check_solution(a: &SparseColMat<usize, f64>, solver: &mut LdltGmres) {
