@@ -210,3 +210,14 @@ fn the_command_line_reports_bad_files_and_writes_the_default_folder() {
     assert!(o.stdout.is_empty() && o.stderr.is_empty(), "--quiet and no terminal: silent");
     assert!(dir.join("good-out/summary.json").is_file());
 }
+
+/// The [solver] keys reach the Newton settings (cycling_after is off unless asked for).
+#[test]
+fn solver_keys_reach_the_newton_settings() {
+    let dir = temp_dir("solver-keys");
+    let plain = build(&Problem::read(&write(&dir, "plain.toml", CANTILEVER)).unwrap()).unwrap();
+    assert_eq!(plain.settings.cycling_after, 0);
+    let text = CANTILEVER.to_string() + "\n[solver]\nline_search_steps = 3\ncycling_after = 8\nmax_cutbacks = 5\n";
+    let tuned = build(&Problem::read(&write(&dir, "tuned.toml", &text)).unwrap()).unwrap();
+    assert_eq!((tuned.settings.line_search_steps, tuned.settings.cycling_after, tuned.settings.max_cutbacks), (3, 8, 5));
+}

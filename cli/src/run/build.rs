@@ -271,5 +271,8 @@ pub fn build(p: &Problem) -> Result<Setup> {
     if let Some(x) = sv.line_search_steps {
         settings.line_search_steps = x;
     }
+    if let Some(x) = sv.cycling_after {
+        settings.cycling_after = x;
+    }
     Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings })
 }

@@ -365,6 +365,10 @@ pub struct SolverSpec {
     pub max_cutbacks: Option<usize>,
     #[serde(default)]
     pub line_search_steps: Option<usize>,
+    /// Give up a step whose active set swings at every iteration without progress from this
+    /// iteration on, and cut it back (off by default; see NewtonSettings::cycling_after).
+    #[serde(default)]
+    pub cycling_after: Option<usize>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
