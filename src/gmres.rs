@@ -16,11 +16,15 @@ pub struct GmresReport {
     pub converged: bool,
 }
 
-/// Workspace of restarted GMRES(m) for systems of size n: the Krylov basis and the Hessenberg
-/// matrix, kept between solves so that a solve allocates nothing.
+/// Workspace of restarted GMRES(m) for systems of size n: the Krylov basis, its preconditioned
+/// images and the Hessenberg matrix, kept between solves so that a solve allocates nothing once
+/// the bases have grown to the iterations a solve needs (vectors are added as needed, up to m).
 pub struct Gmres {
     restart: usize,
     basis: Vec<Vec<f64>>,
+    /// z_k = M^-1 v_k, kept so that the update x += M^-1 V y needs no further preconditioner
+    /// application (as in flexible GMRES, Saad 1993).
+    preconditioned: Vec<Vec<f64>>,
     hessenberg: Vec<f64>,
     cs: Vec<f64>,
     sn: Vec<f64>,
@@ -41,6 +45,7 @@ impl Gmres {
         Gmres {
             restart: m,
             basis: Vec::new(),
+            preconditioned: Vec::new(),
             hessenberg: vec![0.0; (m + 1) * m],
             cs: vec![0.0; m],
             sn: vec![0.0; m],
@@ -72,10 +77,14 @@ impl Gmres {
     ) -> Result<GmresReport, E> {
         let n = b.len();
         let m = self.restart;
-        if self.basis.len() != m + 1 || self.basis[0].len() != n {
-            self.basis = (0..=m).map(|_| vec![0.0; n]).collect();
+        if self.w.len() != n {
+            self.basis.clear();
+            self.preconditioned.clear();
             self.w = vec![0.0; n];
             self.r = vec![0.0; n];
+        }
+        if self.basis.is_empty() {
+            self.basis.push(vec![0.0; n]);
         }
         let b_norm = dot(b, b).sqrt();
         let mut iterations = 0;
@@ -83,12 +92,18 @@ impl Gmres {
             x.iter_mut().for_each(|v| *v = 0.0);
             return Ok(GmresReport { iterations, backward_error: 0.0, converged: true });
         }
+        let mut x_is_zero = x.iter().all(|v| *v == 0.0);
         loop {
             // true residual r = b - A x
-            apply(x, &mut self.r);
-            for (r, bi) in self.r.iter_mut().zip(b) {
-                *r = bi - *r;
+            if x_is_zero {
+                self.r.copy_from_slice(b);
+            } else {
+                apply(x, &mut self.r);
+                for (r, bi) in self.r.iter_mut().zip(b) {
+                    *r = bi - *r;
+                }
             }
+            x_is_zero = false;
             let beta = dot(&self.r, &self.r).sqrt();
             let scale = a_norm * dot(x, x).sqrt() + b_norm;
             let error = beta / scale;
@@ -105,10 +120,17 @@ impl Gmres {
             self.g[0] = beta;
             let mut k = 0;
             while k < m && iterations < max_iterations {
-                // w = A M^-1 v_k
-                self.r.copy_from_slice(&self.basis[k]);
-                precondition(&mut self.r)?;
-                apply(&self.r, &mut self.w);
+                // z_k = M^-1 v_k, w = A z_k
+                if self.preconditioned.len() <= k {
+                    self.preconditioned.push(vec![0.0; n]);
+                }
+                if self.basis.len() <= k + 1 {
+                    self.basis.push(vec![0.0; n]);
+                }
+                let z = &mut self.preconditioned[k];
+                z.copy_from_slice(&self.basis[k]);
+                precondition(z)?;
+                apply(z, &mut self.w);
                 iterations += 1;
                 for i in 0..=k {
                     let hik = dot(&self.w, &self.basis[i]);
@@ -144,7 +166,7 @@ impl Gmres {
                     break;
                 }
             }
-            // x += M^-1 V y, H y = g
+            // x += M^-1 V y = Z y, H y = g
             for i in (0..k).rev() {
                 let mut s = self.g[i];
                 for j in i + 1..k {
@@ -153,16 +175,11 @@ impl Gmres {
                 let hii = self.hessenberg[i * (m + 1) + i];
                 self.y[i] = if hii != 0.0 { s / hii } else { 0.0 };
             }
-            self.r.iter_mut().for_each(|v| *v = 0.0);
             for j in 0..k {
                 let yj = self.y[j];
-                for (r, v) in self.r.iter_mut().zip(&self.basis[j]) {
-                    *r += yj * v;
+                for (xi, z) in x.iter_mut().zip(&self.preconditioned[j]) {
+                    *xi += yj * z;
                 }
-            }
-            precondition(&mut self.r)?;
-            for (xi, d) in x.iter_mut().zip(&self.r) {
-                *xi += d;
             }
         }
     }

@@ -266,9 +266,9 @@ impl LdltGmres {
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
         let (col_ptr, row_idx, row_values, factor) = (&self.col_ptr, &self.row_idx, &self.row_values, &self.factor);
         let parallel = matches!(par, Par::Rayon(_));
-        // initial guess S^-1 b
-        b.copy_from_slice(&self.rhs);
-        Self::ldlt_solve(sym, factor, buffer, par, b);
+        // from x = 0: the first iteration finds the best multiple of S^-1 b, as good as starting
+        // from S^-1 b and one preconditioner application cheaper
+        b.iter_mut().for_each(|v| *v = 0.0);
         let report = self.gmres.solve(
             &self.rhs,
             b,
