@@ -23,21 +23,32 @@
 //!
 //! Ordering ([`Ordering`], [`LdltGmres::ordering`]): by default nested dissection (METIS on the
 //! nodal graph, [`crate::ordering::nested_dissection`]) from [`ND_MIN_UNKNOWNS`] unknowns on and
-//! faer's AMD below. Measured on the tangent of `stamp bench`'s plate (n x n, contact active; the
-//! ignored test `ordering_comparison` in cli/src/bench.rs; 2 cores shared with other work, so the
-//! times are the minimum of 3 and noisy, the fill is exact):
+//! faer's AMD below. Measured 2026-11-23 on the tangent of `stamp bench`'s plate (n x n, punch
+//! travel 0.6, contact active; the ignored test `ordering_comparison` in cli/src/bench.rs): one
+//! symbolic and three numeric factorisations of its symmetric part per ordering, the numeric ones
+//! of the two orderings taking turns, 2 threads on the 2 cores, the minimum of the 3 seconds. The
+//! fill (faer's `len_val`) and the flops (sum over the columns of L of their count squared) are
+//! exact; the seconds are those of the quietest run (load average below 2):
 //!
-//! | n | unknowns | entries of L, AMD / ND | flops ND / AMD | symbolic s, AMD / ND (ordering incl.) | numeric s, AMD / ND |
+//! | n | unknowns | entries of L, AMD / ND | flops, AMD / ND | symbolic s, AMD / ND (METIS incl.) | numeric s, AMD / ND |
 //! |---|---|---|---|---|---|
-//! | 50 | 15 200 | 2.54 M / 2.46 M | 0.93 | 0.03 / 0.03 | 0.055-0.075 / 0.066-0.096 |
-//! | 100 | 60 400 | 13.9 M / 12.6 M | 0.73 | 0.12 / 0.14 | 0.29-0.42 / 0.32-0.40 |
-//! | 120 | 86 880 | 21.8 M / 19.2 M | 0.69 | 0.18 / 0.19 | 0.46-0.73 / 0.48-0.65 |
-//! | 141 | 119 850 | 36.6 M / 28.5 M | 0.51 | 0.30 / 0.26 | 1.16-1.52 / 0.97-1.07 |
-//! | 200 | 240 800 | 75.2 M / 61.7 M | 0.54 | 0.67 / 0.76 | 1.87 / 1.56 |
-//! | 400 | 961 600 | 398 M / 310 M | 0.50 | 2.46 / 2.59 | 27.6 / 17.2 |
+//! | 25 | 3 850 | 0.49 M / 0.45 M | 5.7e7 / 5.0e7 | 0.006 / 0.005 | 0.011 / 0.012 |
+//! | 50 | 15 200 | 2.54 M / 2.46 M | 4.9e8 / 4.6e8 | 0.026 / 0.022 | 0.056 / 0.068 |
+//! | 100 | 60 400 | 13.9 M / 12.6 M | 5.3e9 / 3.9e9 | 0.16 / 0.13 | 0.30 / 0.32 |
+//! | 120 | 86 880 | 21.8 M / 19.2 M | 9.8e9 / 6.8e9 | 0.21 / 0.21 | 0.51 / 0.61 |
+//! | 141 | 119 850 | 36.6 M / 28.5 M | 2.2e10 / 1.1e10 | 0.25 / 0.27 | 0.89 / 0.74 |
+//! | 200 | 240 800 | 75.2 M / 61.7 M | 6.0e10 / 3.2e10 | 0.50 / 0.56 | 1.84 / 1.51 |
+//! | 400 | 961 600 | 398 M / 310 M | 6.4e11 / 3.2e11 | 2.41 / 2.52 | 15.0 / 10.3 |
 //!
-//! Below about 100 000 unknowns ND saves flops but not time (smaller supernodes at the leaves of
-//! the dissection), above it saves both; a failure of METIS falls back to AMD.
+//! Other runs, while another benchmark shared the machine (load average up to 3.9), moved the
+//! seconds by up to 85 %. Over all runs, at 60 400 and 86 880 unknowns either ordering came out
+//! ahead (AMD in 8 of 12; ND saves flops there, not time); from 119 850 unknowns on (n = 141,
+//! 160, 200, 400) ND was faster in all 15, by 13 % or more, and its factor is 18-22 % smaller.
+//! METIS takes 0.09 s at n = 100, 0.3 s at 200, 1.4 s at 400, once per pattern; if it fails,
+//! AMD is used. The whole bench solve (the ignored test `ordering_bench`, one run each, load
+//! average about 2) at n = 200: 86 s with ND against 103 s with AMD (factorisations 44 s against
+//! 54 s, solves 29 s against 35 s), the same answer; at n = 100 (where the default stays AMD)
+//! 18.3 s against 19.2 s, the factorisations 8.4 s either way.
 //!
 //! Reuse of the numeric factor (off by default, [`LdltGmres::reuse`]): a new matrix of the same
 //! pattern (the next Newton iteration) is first solved by GMRES preconditioned with the factor of
@@ -71,8 +82,9 @@ pub const GMRES_MAX_ITERATIONS: usize = 200;
 pub const GMRES_RESTART: usize = 40;
 /// Relative asymmetry max |a_ij - a_ji| / max |a| up to which A is treated as symmetric.
 pub const SYMMETRY_TOL: f64 = 1e-12;
-/// Unknowns from which [`Ordering::Auto`] orders by nested dissection (measured crossover: a tie
-/// at 60 400 and 86 880 unknowns, ND 15-30 % faster at 119 850, see the module doc).
+/// Unknowns from which [`Ordering::Auto`] orders by nested dissection (measured on the bench
+/// plate: a tie or AMD ahead at 60 400 and 86 880 unknowns, ND ahead by 13 % or more from 119 850
+/// on, see the module doc).
 pub const ND_MIN_UNKNOWNS: usize = 100_000;
 /// Backward error of a direct LDL^T solve accepted without refinement.
 const ACCEPT: f64 = 1e-14;
