@@ -18,8 +18,37 @@
 //! - A matrix whose LDL^T meets a zero pivot, whose pattern is not symmetric, or on which the
 //!   solve does not reach its tolerance is factorised by [`SparseLu`] instead (that matrix only).
 //!
-//! The symbolic phase (AMD ordering, elimination tree, supernodes) is computed once per pattern
-//! and reused, with all workspaces, by every numeric factorisation.
+//! The symbolic phase (fill-reducing ordering, elimination tree, supernodes) is computed once per
+//! pattern and reused, with all workspaces, by every numeric factorisation.
+//!
+//! Ordering ([`Ordering`], [`LdltGmres::ordering`]): by default nested dissection (METIS on the
+//! nodal graph, [`crate::ordering::nested_dissection`]) from [`ND_MIN_UNKNOWNS`] unknowns on and
+//! faer's AMD below. Measured 2026-11-23 on the tangent of `stamp bench`'s plate (n x n, punch
+//! travel 0.6, contact active; the ignored test `ordering_comparison` in cli/src/bench.rs): one
+//! symbolic and three numeric factorisations of its symmetric part per ordering, the numeric ones
+//! of the two orderings taking turns, 2 threads on the 2 cores, the minimum of the 3 seconds. The
+//! fill (faer's `len_val`) and the flops (sum over the columns of L of their count squared) are
+//! exact; the seconds are those of the quietest run (load average below 2):
+//!
+//! | n | unknowns | entries of L, AMD / ND | flops, AMD / ND | symbolic s, AMD / ND (METIS incl.) | numeric s, AMD / ND |
+//! |---|---|---|---|---|---|
+//! | 25 | 3 850 | 0.49 M / 0.45 M | 5.7e7 / 5.0e7 | 0.006 / 0.005 | 0.011 / 0.012 |
+//! | 50 | 15 200 | 2.54 M / 2.46 M | 4.9e8 / 4.6e8 | 0.026 / 0.022 | 0.056 / 0.068 |
+//! | 100 | 60 400 | 13.9 M / 12.6 M | 5.3e9 / 3.9e9 | 0.16 / 0.13 | 0.30 / 0.32 |
+//! | 120 | 86 880 | 21.8 M / 19.2 M | 9.8e9 / 6.8e9 | 0.21 / 0.21 | 0.51 / 0.61 |
+//! | 141 | 119 850 | 36.6 M / 28.5 M | 2.2e10 / 1.1e10 | 0.25 / 0.27 | 0.89 / 0.74 |
+//! | 200 | 240 800 | 75.2 M / 61.7 M | 6.0e10 / 3.2e10 | 0.50 / 0.56 | 1.84 / 1.51 |
+//! | 400 | 961 600 | 398 M / 310 M | 6.4e11 / 3.2e11 | 2.41 / 2.52 | 15.0 / 10.3 |
+//!
+//! Other runs, while another benchmark shared the machine (load average up to 3.9), moved the
+//! seconds by up to 85 %. Over all runs, at 60 400 and 86 880 unknowns either ordering came out
+//! ahead (AMD in 8 of 12; ND saves flops there, not time); from 119 850 unknowns on (n = 141,
+//! 160, 200, 400) ND was faster in all 15, by 13 % or more, and its factor is 18-22 % smaller.
+//! METIS takes 0.09 s at n = 100, 0.3 s at 200, 1.4 s at 400, once per pattern; if it fails,
+//! AMD is used. The whole bench solve (the ignored test `ordering_bench`, one run each, load
+//! average about 2) at n = 200: 86 s with ND against 103 s with AMD (factorisations 44 s against
+//! 54 s, solves 29 s against 35 s), the same answer; at n = 100 (where the default stays AMD)
+//! 18.3 s against 19.2 s, the factorisations 8.4 s either way.
 //!
 //! Reuse of the numeric factor (off by default, [`LdltGmres::reuse`]): a new matrix of the same
 //! pattern (the next Newton iteration) is first solved by GMRES preconditioned with the factor of
@@ -36,10 +65,12 @@
 use crate::error::{Result, StampError};
 use crate::gmres::{Gmres, GmresReport};
 use crate::linear_solver::{parallelism_for, LinearSolver, SolverTimings, SparseLu};
+use crate::ordering;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymmetricOrdering};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::perm::PermRef;
 use faer::{Conj, MatMut, Par, Side};
 use std::time::Instant;
 
@@ -51,10 +82,27 @@ pub const GMRES_MAX_ITERATIONS: usize = 200;
 pub const GMRES_RESTART: usize = 40;
 /// Relative asymmetry max |a_ij - a_ji| / max |a| up to which A is treated as symmetric.
 pub const SYMMETRY_TOL: f64 = 1e-12;
+/// Unknowns from which [`Ordering::Auto`] orders by nested dissection (measured on the bench
+/// plate: a tie or AMD ahead at 60 400 and 86 880 unknowns, ND ahead by 13 % or more from 119 850
+/// on, see the module doc).
+pub const ND_MIN_UNKNOWNS: usize = 100_000;
 /// Backward error of a direct LDL^T solve accepted without refinement.
 const ACCEPT: f64 = 1e-14;
 /// Backward error above which, after refinement, the matrix goes to the LU.
 const FALLBACK: f64 = 1e-10;
+
+/// Fill-reducing ordering of the LDL^T factor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Ordering {
+    /// faer's approximate minimum degree.
+    Amd,
+    /// Nested dissection by METIS on the compressed (nodal) graph,
+    /// [`crate::ordering::nested_dissection`]; AMD if METIS fails.
+    NestedDissection,
+    /// Nested dissection from [`ND_MIN_UNKNOWNS`] unknowns on, AMD below (the default).
+    #[default]
+    Auto,
+}
 
 /// How the last matrix is solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,6 +132,10 @@ pub struct LdltGmresStats {
 /// LDL^T of the symmetric part, direct or as GMRES preconditioner; LU fallback.
 pub struct LdltGmres {
     symbolic: Option<SymbolicCholesky<usize>>,
+    /// The ordering asked for, and the one the current symbolic factor uses (Amd or
+    /// NestedDissection).
+    ordering: Ordering,
+    ordering_used: Option<Ordering>,
     factor: Vec<f64>,
     /// Pattern and values of the last matrix A, and the values of its symmetric part.
     col_ptr: Vec<usize>,
@@ -137,6 +189,8 @@ impl LdltGmres {
     pub fn new() -> Self {
         LdltGmres {
             symbolic: None,
+            ordering: Ordering::default(),
+            ordering_used: None,
             factor: Vec::new(),
             col_ptr: Vec::new(),
             row_idx: Vec::new(),
@@ -178,6 +232,25 @@ impl LdltGmres {
         self
     }
 
+    /// The fill-reducing ordering (default [`Ordering::Auto`]); takes effect at the next new
+    /// pattern.
+    pub fn ordering(mut self, ordering: Ordering) -> Self {
+        self.ordering = ordering;
+        self
+    }
+
+    /// The ordering of the current LDL^T factor ([`Ordering::Amd`] or
+    /// [`Ordering::NestedDissection`]); None before the first symmetric pattern.
+    pub fn ordering_used(&self) -> Option<Ordering> {
+        self.ordering_used
+    }
+
+    /// Stored entries of the LDL^T factor of the current pattern (faer's `len_val`); 0 before the
+    /// first symmetric pattern.
+    pub fn factor_len(&self) -> usize {
+        self.symbolic.as_ref().map_or(0, |s| s.len_val())
+    }
+
     /// What the solver did so far.
     pub fn stats(&self) -> LdltGmresStats {
         self.stats
@@ -193,10 +266,25 @@ impl LdltGmres {
         self.row_values = vec![0.0; self.row_idx.len()];
         self.transpose = transpose_positions(&self.col_ptr, &self.row_idx);
         self.symbolic = None;
+        self.ordering_used = None;
         self.factor_valid = false;
         if self.transpose.is_some() {
-            let sym = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, CholeskySymbolicParams::default())
+            let n = a.nrows();
+            let nested = match self.ordering {
+                Ordering::Amd => false,
+                Ordering::NestedDissection => true,
+                Ordering::Auto => n >= ND_MIN_UNKNOWNS,
+            };
+            // a METIS failure leaves AMD
+            let perm = if nested { ordering::nested_dissection(&self.col_ptr, &self.row_idx).ok() } else { None };
+            let inverse = perm.as_deref().map(ordering::inverse);
+            let order = match (&perm, &inverse) {
+                (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, n)),
+                _ => SymmetricOrdering::Amd,
+            };
+            let sym = factorize_symbolic_cholesky(a.symbolic(), Side::Lower, order, CholeskySymbolicParams::default())
                 .map_err(|e| StampError::LinearSolver(format!("symbolic LDL^T failed: {e:?}")))?;
+            self.ordering_used = Some(if perm.is_some() { Ordering::NestedDissection } else { Ordering::Amd });
             let scratch = sym.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default()).or(sym.solve_in_place_scratch::<f64>(1, self.par));
             self.buffer = Some(MemBuffer::try_new(scratch).map_err(|_| StampError::LinearSolver("out of memory for the LDL^T workspace".into()))?);
             self.factor = vec![0.0; sym.len_val()];
@@ -630,6 +718,46 @@ mod tests {
         check_solution(&tridiagonal(400, 0.2, 0.01), &mut s);
         check_solution(&tridiagonal(400, 0.21, 0.011), &mut s);
         assert_eq!((s.stats().reused, s.timings().factorizations), (0, 2));
+    }
+
+    /// A k x k grid Laplacian with a skew part on the x couplings.
+    fn grid(k: usize, skew: f64) -> SparseColMat<usize, f64> {
+        let mut e = Vec::new();
+        for (x, y) in (0..k).flat_map(|x| (0..k).map(move |y| (x, y))) {
+            let i = x * k + y;
+            e.push((i, i, 4.01));
+            if x + 1 < k {
+                e.extend([(i, i + k, -1.0 + skew), (i + k, i, -1.0 - skew)]);
+            }
+            if y + 1 < k {
+                e.extend([(i, i + 1, -1.0), (i + 1, i, -1.0)]);
+            }
+        }
+        matrix(k * k, &e)
+    }
+
+    #[test]
+    fn both_orderings_solve_the_same_systems() {
+        for skew in [0.0, 0.3] {
+            let a = grid(40, skew);
+            let mut amd = LdltGmres::new().ordering(Ordering::Amd);
+            let mut nd = LdltGmres::new().ordering(Ordering::NestedDissection);
+            // Auto: AMD below ND_MIN_UNKNOWNS
+            let mut auto = LdltGmres::new();
+            for s in [&mut amd, &mut nd, &mut auto] {
+                check_solution(&a, s);
+                assert_eq!(s.stats().lu_fallbacks, 0);
+            }
+            assert_eq!(amd.ordering_used(), Some(Ordering::Amd));
+            assert_eq!(nd.ordering_used(), Some(Ordering::NestedDissection));
+            assert_eq!(auto.ordering_used(), Some(Ordering::Amd));
+            assert!(nd.factor_len() > 0 && nd.factor_len() != amd.factor_len());
+            assert_eq!(auto.factor_len(), amd.factor_len());
+        }
+        // a structurally non-symmetric pattern: no LDL^T, no ordering
+        let mut s = LdltGmres::new().ordering(Ordering::NestedDissection);
+        check_solution(&matrix(3, &[(0, 0, 2.0), (0, 1, 1.0), (1, 1, 3.0), (2, 2, 1.0), (2, 0, 0.5)]), &mut s);
+        assert_eq!((s.ordering_used(), s.factor_len()), (None, 0));
     }
 
     #[test]

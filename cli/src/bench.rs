@@ -233,3 +233,131 @@ pub fn one_command(n: usize, reuse: bool) -> Result<()> {
     println!("{}", serde_json::to_string(&run).map_err(|e| StampError::Problem(e.to_string()))?);
     Ok(())
 }
+
+#[cfg(test)]
+mod ordering_measurement {
+    //! Not tests: the measurements behind `stamp::ldlt_gmres::Ordering` (ignored; run with
+    //! `STAMP_ORDERING_SIZES=100,200 cargo test --release -p stamp-cli --lib ordering_ -- --ignored --nocapture --test-threads 1`;
+    //! STAMP_ORDERING_NUMERIC=0 skips the numeric factorisations of `ordering_comparison`).
+    use super::*;
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymmetricOrdering};
+    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    use faer::perm::PermRef;
+    use faer::Side;
+
+    /// The bench model's tangent at load factor t (punch travel 2 t: contact active), its pattern
+    /// and the values of its symmetric part.
+    fn tangent(n: usize, t: f64) -> (usize, Vec<usize>, Vec<usize>, Vec<f64>) {
+        let mut model = build(n).unwrap();
+        let mut u = vec![0.0; model.num_dofs()];
+        model.apply_prescribed(&mut u, t);
+        model.evaluate(&u, t, true).unwrap();
+        let a = model.matrix();
+        let (cp, ri, v) = (a.symbolic().col_ptr().to_vec(), a.symbolic().row_idx().to_vec(), a.val());
+        let mut s = vec![0.0; v.len()];
+        for j in 0..a.ncols() {
+            for k in cp[j]..cp[j + 1] {
+                let i = ri[k];
+                let p = cp[i] + ri[cp[i]..cp[i + 1]].binary_search(&j).expect("symmetric pattern");
+                s[k] = 0.5 * (v[k] + v[p]);
+            }
+        }
+        (a.ncols(), cp, ri, s)
+    }
+
+    /// Multiply-adds of the LDL^T: sum over the columns of L of (entries below the diagonal)^2.
+    fn flops(sym: &faer::sparse::linalg::cholesky::SymbolicCholesky<usize>) -> f64 {
+        use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+        let count = |c: usize| (c * c) as f64;
+        match sym.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => (0..s.n_supernodes())
+                .map(|k| {
+                    let w = s.supernode_end()[k] - s.supernode_begin()[k];
+                    let r = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
+                    (0..w).map(|i| count(w - 1 - i + r)).sum::<f64>()
+                })
+                .sum(),
+            SymbolicCholeskyRaw::Simplicial(s) => (0..s.ncols()).map(|j| count(s.col_ptr()[j + 1] - s.col_ptr()[j] - 1)).sum(),
+        }
+    }
+
+    #[test]
+    #[ignore]
+    fn ordering_comparison() {
+        let sizes: Vec<usize> = std::env::var("STAMP_ORDERING_SIZES").unwrap_or("100,200".into()).split(',').map(|s| s.trim().parse().unwrap()).collect();
+        let numeric = std::env::var("STAMP_ORDERING_NUMERIC").map(|v| v != "0").unwrap_or(true);
+        let par = faer::get_global_parallelism();
+        println!("n | unknowns | nnz(A) | ordering | nnz(L) | flops | ordering s | symbolic s (incl. ordering) | numeric s (min of 3)");
+        for n in sizes {
+            let (neq, cp, ri, s) = tangent(n, 0.3);
+            let pattern = SymbolicSparseColMatRef::new_checked(neq, neq, &cp, None, &ri);
+            let a = SparseColMatRef::new(pattern, &s);
+            // symbolic phases first, then the numeric factorisations of both orderings in turns,
+            // so that both meet the same load of the (shared) machine
+            let mut runs = Vec::new();
+            for name in ["AMD", "ND"] {
+                let t0 = Instant::now();
+                let perm = (name == "ND").then(|| stamp::ordering::nested_dissection(&cp, &ri).unwrap());
+                let t_order = t0.elapsed().as_secs_f64();
+                let inv = perm.as_ref().map(|p| stamp::ordering::inverse(p));
+                let ord = match (&perm, &inv) {
+                    (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, neq)),
+                    _ => SymmetricOrdering::Amd,
+                };
+                let sym = factorize_symbolic_cholesky(pattern, Side::Lower, ord, Default::default()).unwrap();
+                let t_sym = t0.elapsed().as_secs_f64();
+                runs.push((name, sym, t_order, t_sym, f64::INFINITY));
+            }
+            if numeric {
+                for _ in 0..3 {
+                    for run in runs.iter_mut() {
+                        let sym = &run.1;
+                        let scratch = sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
+                        let mut buffer = MemBuffer::new(scratch);
+                        let mut factor = vec![0.0; sym.len_val()];
+                        // touch the memory first, as a solver that keeps its factor would have
+                        factor.iter_mut().for_each(|x| *x = 1.0);
+                        let t1 = Instant::now();
+                        sym.factorize_numeric_ldlt(&mut factor, a, Side::Lower, Default::default(), par, MemStack::new(&mut buffer), Default::default()).unwrap();
+                        run.4 = run.4.min(t1.elapsed().as_secs_f64());
+                    }
+                }
+            }
+            for (name, sym, t_order, t_sym, best) in &runs {
+                println!("{n} | {neq} | {} | {name} | {} | {:.3e} | {t_order:.3} | {t_sym:.3} | {best:.3}", ri.len(), sym.len_val(), flops(sym));
+            }
+        }
+    }
+
+    /// The whole benchmark solve (as `stamp bench`) under each ordering.
+    #[test]
+    #[ignore]
+    fn ordering_bench() {
+        use stamp::ldlt_gmres::Ordering;
+        let sizes: Vec<usize> = std::env::var("STAMP_ORDERING_SIZES").unwrap_or("100,200".into()).split(',').map(|s| s.trim().parse().unwrap()).collect();
+        println!("n | ordering | Newton | factorisations | GMRES | symbolic s | factor s | solve s | total s | centre deflection");
+        for n in sizes {
+            for ordering in [Ordering::Amd, Ordering::NestedDissection] {
+                let start = Instant::now();
+                let mut model = build(n).unwrap();
+                let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, ..NewtonSettings::default() };
+                let mut newton = NewtonRaphson::new(LdltGmres::new().ordering(ordering), settings);
+                let mut u = vec![0.0; model.num_dofs()];
+                let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
+                let st = newton.linear.timings();
+                let centre = 0.5 * (u[2] + u[5]);
+                println!(
+                    "{n} | {ordering:?} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {centre:.9}",
+                    summary.newton_iterations,
+                    st.factorizations,
+                    newton.linear.stats().gmres_iterations,
+                    st.symbolic,
+                    st.factorization,
+                    st.solve,
+                    start.elapsed().as_secs_f64()
+                );
+            }
+        }
+    }
+}
