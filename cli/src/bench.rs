@@ -361,3 +361,38 @@ mod ordering_measurement {
         }
     }
 }
+
+#[cfg(test)]
+mod assembly_measurement {
+    //! Not a test: one full assembly (residual and tangent) of the bench model with one and with
+    //! two threads, and a residual-only one (ignored; run with
+    //! `STAMP_ASSEMBLY_SIZES=200,400 cargo test --release -p stamp-cli --lib assembly_threads -- --ignored --nocapture`).
+    use super::*;
+
+    #[test]
+    #[ignore]
+    fn assembly_threads() {
+        let sizes: Vec<usize> = std::env::var("STAMP_ASSEMBLY_SIZES").unwrap_or("200".into()).split(',').map(|s| s.trim().parse().unwrap()).collect();
+        println!("n | unknowns | full assembly s, 1 thread | 2 threads | speed-up | residual only s, 2 threads (min of 5)");
+        for n in sizes {
+            let mut model = build(n).unwrap();
+            let mut u = vec![0.0; model.num_dofs()];
+            model.apply_prescribed(&mut u, 0.3);
+            let mut time = |threads: usize, tangent: bool| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| {
+                    model.evaluate(&u, 0.3, tangent).unwrap();
+                    (0..5)
+                        .map(|_| {
+                            let t = Instant::now();
+                            model.evaluate(&u, 0.3, tangent).unwrap();
+                            t.elapsed().as_secs_f64()
+                        })
+                        .fold(f64::INFINITY, f64::min)
+                })
+            };
+            let (one, two, residual) = (time(1, true), time(2, true), time(2, false));
+            println!("{n} | {} | {one:.3} | {two:.3} | {:.2} | {residual:.3}", model.num_equations(), one / two);
+        }
+    }
+}

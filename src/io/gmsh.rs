@@ -46,7 +46,7 @@ pub struct PhysicalGroup {
 }
 
 impl PhysicalGroup {
-    /// The key "#<tag>" under which the group is always stored.
+    /// The key `"#<tag>"` under which the group is always stored.
     pub fn number_key(&self) -> String {
         format!("#{}", self.tag)
     }
@@ -54,7 +54,7 @@ impl PhysicalGroup {
 
 /// A mesh read from a gmsh file, with its physical groups.
 ///
-/// Groups are keyed by name and by number as "#<tag>" (a named group has both keys). In
+/// Groups are keyed by name and by number as `"#<tag>"` (a named group has both keys). In
 /// `mesh.node_groups`, which mixes dimensions, a name used by groups of several dimensions holds the
 /// union of their nodes, and a number used by groups of several dimensions is left out (ambiguous:
 /// look it up with [`GmshMesh::point_group`], [`GmshMesh::curve_group`] or
@@ -172,7 +172,7 @@ impl GmshMesh {
             .ok_or_else(|| self.unknown("surface group", name, self.mesh.cell_groups.keys().collect()))
     }
 
-    /// All group keys (names and "#<tag>" numbers) of `mesh.node_groups`.
+    /// All group keys (names and `"#<tag>"` numbers) of `mesh.node_groups`.
     pub fn group_names(&self) -> Vec<String> {
         self.mesh.node_groups.keys().cloned().collect()
     }
