@@ -12,13 +12,12 @@ fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / norm
 }
 
-/// The tangent of a deformed, contacting plate: not symmetric (b_ab33 = 0), so the solver takes the
-/// preconditioned path, and its solution is the LU's.
-#[test]
-fn plate_tangent_is_solved_like_the_lu() {
-    let p = SphereProblem::new(40.0, 1.0, 12, Support::Clamped);
+/// The clamped sphere problem on an n x n mesh evaluated at a random displacement (seed `seed`):
+/// the model holding the tangent, the residual as right-hand side and the LU's solution.
+fn deformed_tangent(n: usize, seed: u64) -> (stamp::model::Model<stamp_elements::PlateElements>, Vec<f64>, Vec<f64>) {
+    let p = SphereProblem::new(40.0, 1.0, n, Support::Clamped);
     let (_, mut model) = p.build();
-    let mut rng = common::Lcg(7);
+    let mut rng = common::Lcg(seed);
     let u: Vec<f64> = (0..model.num_dofs()).map(|_| 0.05 * (rng.next() - 0.5)).collect();
     model.evaluate(&u, 0.5, true).unwrap();
     let b = model.residual().to_vec();
@@ -26,6 +25,14 @@ fn plate_tangent_is_solved_like_the_lu() {
     lu.factorize(model.matrix()).unwrap();
     let mut x_lu = b.clone();
     lu.solve_in_place(&mut x_lu).unwrap();
+    (model, b, x_lu)
+}
+
+/// The tangent of a deformed, contacting plate: not symmetric (b_ab33 = 0), so the solver takes the
+/// preconditioned path, and its solution is the LU's.
+#[test]
+fn plate_tangent_is_solved_like_the_lu() {
+    let (model, b, x_lu) = deformed_tangent(12, 7);
     let mut fast = LdltGmres::new();
     fast.factorize(model.matrix()).unwrap();
     let mut x = b.clone();
@@ -42,16 +49,7 @@ fn plate_tangent_is_solved_like_the_lu() {
 /// dissection with the smaller factor on this 24 x 24 mesh.
 #[test]
 fn plate_tangent_is_solved_alike_under_amd_and_nested_dissection() {
-    let p = SphereProblem::new(40.0, 1.0, 24, Support::Clamped);
-    let (_, mut model) = p.build();
-    let mut rng = common::Lcg(11);
-    let u: Vec<f64> = (0..model.num_dofs()).map(|_| 0.05 * (rng.next() - 0.5)).collect();
-    model.evaluate(&u, 0.5, true).unwrap();
-    let b = model.residual().to_vec();
-    let mut lu = SparseLu::new();
-    lu.factorize(model.matrix()).unwrap();
-    let mut x_lu = b.clone();
-    lu.solve_in_place(&mut x_lu).unwrap();
+    let (model, b, x_lu) = deformed_tangent(24, 11);
     let mut len = Vec::new();
     for ordering in [Ordering::Amd, Ordering::NestedDissection] {
         let mut fast = LdltGmres::new().ordering(ordering);
