@@ -101,26 +101,11 @@ pub fn closed_pattern<'a>(col_ptr: &'a [usize], row_idx: &'a [usize]) -> (Cow<'a
 /// stored.
 fn is_closed_symmetric(col_ptr: &[usize], row_idx: &[usize]) -> bool {
     let n = col_ptr.len() - 1;
-    // walking the columns in order meets the entries of row i by increasing column: the k-th of
-    // them, (i, j), must be the k-th entry (j, i) of column i
-    let mut seen = vec![0usize; n];
-    for j in 0..n {
+    let sorted_with_diagonal = (0..n).all(|j| {
         let col = &row_idx[col_ptr[j]..col_ptr[j + 1]];
-        if col.windows(2).any(|w| w[0] >= w[1]) || col.binary_search(&j).is_err() {
-            return false;
-        }
-        for &i in col {
-            if i >= n {
-                return false;
-            }
-            let partner = col_ptr[i] + seen[i];
-            if partner >= col_ptr[i + 1] || row_idx[partner] != j {
-                return false;
-            }
-            seen[i] += 1;
-        }
-    }
-    (0..n).all(|i| seen[i] == col_ptr[i + 1] - col_ptr[i])
+        col.windows(2).all(|w| w[0] < w[1]) && col.binary_search(&j).is_ok()
+    });
+    sorted_with_diagonal && crate::sparse::pair_transposed(col_ptr, row_idx, |_, _| {})
 }
 
 /// Group the vertices of a graph by closed neighbourhood; `ptr` / `adj`: the closed

@@ -234,3 +234,29 @@ impl SparsePattern {
         self.rank[dof] as u32
     }
 }
+
+/// Pair every stored entry (i, j) of a compressed-column pattern with the position of (j, i):
+/// calls `pair(k, partner)` for each stored position k, in column order. Returns false (and stops)
+/// as soon as an entry has no transposed partner or a row index is out of range: the pattern is
+/// not symmetric. Row indices must be sorted within each column (faer's invariant).
+pub fn pair_transposed(col_ptr: &[usize], row_idx: &[usize], mut pair: impl FnMut(usize, usize)) -> bool {
+    let n = col_ptr.len() - 1;
+    // walking the columns in order visits each row's entries by increasing column: the k-th entry
+    // of row i met this way is (i, j_k), and its partner (j_k, i) is the k-th entry of column i
+    let mut seen = vec![0usize; n];
+    for j in 0..n {
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            let i = row_idx[k];
+            if i >= n {
+                return false;
+            }
+            let partner = col_ptr[i] + seen[i];
+            if partner >= col_ptr[i + 1] || row_idx[partner] != j {
+                return false;
+            }
+            pair(k, partner);
+            seen[i] += 1;
+        }
+    }
+    (0..n).all(|i| seen[i] == col_ptr[i + 1] - col_ptr[i])
+}
