@@ -171,8 +171,6 @@ pub struct LdltGmres {
     par: Par,
     timings: SolverTimings,
     stats: LdltGmresStats,
-    /// Relative residual at which the current solve may stop (0: to [`GMRES_TOL`] only).
-    rtol: f64,
     /// Workspaces of a solve.
     rhs: Vec<f64>,
     r: Vec<f64>,
@@ -215,7 +213,6 @@ impl LdltGmres {
             par: faer::get_global_parallelism(),
             timings: SolverTimings::default(),
             stats: LdltGmresStats::default(),
-            rtol: 0.0,
             rhs: Vec::new(),
             r: Vec::new(),
         }
@@ -349,7 +346,8 @@ impl LdltGmres {
     }
 
     /// GMRES on A preconditioned by the LDL^T of S.
-    fn preconditioned_solve(&mut self, b: &mut [f64], max_iterations: usize) -> GmresReport {
+    /// GMRES stops at a backward error of [`GMRES_TOL`] or at a relative residual `rtol`.
+    fn preconditioned_solve(&mut self, b: &mut [f64], max_iterations: usize, rtol: f64) -> GmresReport {
         let par = parallelism_for(b.len(), self.par);
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
         let (col_ptr, row_idx, row_values, factor) = (&self.col_ptr, &self.row_idx, &self.row_values, &self.factor);
@@ -361,7 +359,7 @@ impl LdltGmres {
             &self.rhs,
             b,
             GMRES_TOL,
-            self.rtol,
+            rtol,
             self.norm_inf,
             max_iterations,
             &mut |x, y| multiply_rows(col_ptr, row_idx, row_values, x, y, parallel),
@@ -449,23 +447,8 @@ fn backward_error(col_ptr: &[usize], row_idx: &[usize], row_values: &[f64], para
 /// For every stored (i, j), the position of (j, i); None if the pattern is not symmetric. Row
 /// indices must be sorted within each column (faer's invariant).
 fn transpose_positions(col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize>> {
-    let n = col_ptr.len() - 1;
-    // walking the columns in order visits each row's entries by increasing column: the k-th entry
-    // of row i met this way is (i, j_k), and its partner (j_k, i) is the k-th entry of column i
-    let mut seen = vec![0usize; n];
     let mut out = vec![0usize; row_idx.len()];
-    for j in 0..n {
-        for k in col_ptr[j]..col_ptr[j + 1] {
-            let i = row_idx[k];
-            let partner = col_ptr[i] + seen[i];
-            if partner >= col_ptr[i + 1] || row_idx[partner] != j {
-                return None;
-            }
-            out[k] = partner;
-            seen[i] += 1;
-        }
-    }
-    (0..n).all(|i| seen[i] == col_ptr[i + 1] - col_ptr[i]).then_some(out)
+    crate::sparse::pair_transposed(col_ptr, row_idx, |k, partner| out[k] = partner).then_some(out)
 }
 
 impl LinearSolver for LdltGmres {
@@ -509,6 +492,11 @@ impl LinearSolver for LdltGmres {
     }
 
     fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()> {
+        self.solve_in_place_to(b, 0.0)
+    }
+
+    fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
+        let rtol = rtol.max(0.0);
         if !self.factored {
             return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
         }
@@ -532,7 +520,7 @@ impl LinearSolver for LdltGmres {
                 let budget = if self.iteration_seconds > 0.0 { (self.factor_seconds / self.iteration_seconds).ceil() as usize } else { GMRES_MAX_ITERATIONS };
                 let max_iterations = if self.stale { (self.fresh_iterations + budget.max(10)).min(GMRES_MAX_ITERATIONS) } else { GMRES_MAX_ITERATIONS };
                 let ts = Instant::now();
-                let report = self.preconditioned_solve(b, max_iterations);
+                let report = self.preconditioned_solve(b, max_iterations, rtol);
                 if report.iterations > 0 {
                     self.iteration_seconds = ts.elapsed().as_secs_f64() / report.iterations as f64;
                 }
@@ -548,7 +536,7 @@ impl LinearSolver for LdltGmres {
                     self.timings.solve += t.elapsed().as_secs_f64();
                     self.fresh_factorization()?;
                     b.copy_from_slice(&self.rhs);
-                    return self.solve_in_place(b);
+                    return self.solve_in_place_to(b, rtol);
                 }
                 report.converged
             }
@@ -562,13 +550,6 @@ impl LinearSolver for LdltGmres {
             return self.lu.as_mut().unwrap().solve_in_place(b);
         }
         Ok(())
-    }
-
-    fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
-        self.rtol = rtol.max(0.0);
-        let result = self.solve_in_place(b);
-        self.rtol = 0.0;
-        result
     }
 
     fn timings(&self) -> SolverTimings {
