@@ -189,15 +189,19 @@ impl Gmres {
 mod tests {
     use super::*;
 
+    /// y = A x for the non-symmetric tridiagonal A = (-1.5, 4, -0.5).
+    fn tridiagonal(x: &[f64], y: &mut [f64]) {
+        let n = x.len();
+        for i in 0..n {
+            y[i] = 4.0 * x[i] + if i > 0 { -1.5 * x[i - 1] } else { 0.0 } + if i + 1 < n { -0.5 * x[i + 1] } else { 0.0 };
+        }
+    }
+
     /// A non-symmetric tridiagonal system with a known solution, preconditioned by its diagonal.
     #[test]
     fn solves_a_nonsymmetric_system() {
         let n = 200;
-        let apply = |x: &[f64], y: &mut [f64]| {
-            for i in 0..n {
-                y[i] = 4.0 * x[i] + if i > 0 { -1.5 * x[i - 1] } else { 0.0 } + if i + 1 < n { -0.5 * x[i + 1] } else { 0.0 };
-            }
-        };
+        let apply = tridiagonal;
         let exact: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
         let mut b = vec![0.0; n];
         apply(&exact, &mut b);
@@ -220,13 +224,9 @@ mod tests {
     #[test]
     fn stops_at_a_relative_residual() {
         let n = 200;
-        let apply = |x: &[f64], y: &mut [f64]| {
-            for i in 0..n {
-                y[i] = 4.0 * x[i] + if i > 0 { -1.5 * x[i - 1] } else { 0.0 } + if i + 1 < n { -0.5 * x[i + 1] } else { 0.0 };
-            }
-        };
+        let apply = tridiagonal;
         let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
-        let mut solve = |rtol: f64| {
+        let solve = |rtol: f64| {
             let mut x = vec![0.0; n];
             let report = Gmres::new(50)
                 .solve(&b, &mut x, 1e-14, rtol, 0.0, 500, &mut |x, y| apply(x, y), &mut |_: &mut [f64]| -> Result<(), ()> { Ok(()) })

@@ -122,7 +122,6 @@ pub struct NewtonSettings {
 /// Iterations in a row with a changing active set that count as cycling.
 pub const CYCLING_WINDOW: usize = 6;
 
-
 impl Default for NewtonSettings {
     fn default() -> Self {
         NewtonSettings {

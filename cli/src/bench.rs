@@ -96,6 +96,19 @@ fn build(n: usize) -> Result<Model<PlateElements>> {
     Ok(model)
 }
 
+/// The load stepping and Newton settings of the benchmark. First contact of a fine mesh swings
+/// the active set wholesale: such a step is given up early (`cycling_after`).
+fn settings() -> NewtonSettings {
+    NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, cycling_after: 8, ..NewtonSettings::default() }
+}
+
+/// Sizes for the ignored measurements below: the comma-separated list in environment variable
+/// `var`, else `default`.
+#[cfg(test)]
+fn sizes_from_env(var: &str, default: &str) -> Vec<usize> {
+    std::env::var(var).unwrap_or(default.into()).split(',').map(|s| s.trim().parse().unwrap()).collect()
+}
+
 /// Peak resident memory of this process (Linux: VmHWM of /proc/self/status), 0 where unknown.
 pub fn peak_rss_bytes() -> u64 {
     let Ok(status) = std::fs::read_to_string("/proc/self/status") else { return 0 };
@@ -115,9 +128,7 @@ pub fn run_one(n: usize, reuse: bool) -> Result<BenchRun> {
     }
     let start = Instant::now();
     let mut model = build(n)?;
-    // first contact of a fine mesh swings the active set wholesale: give such a step up early
-    let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, cycling_after: 8, ..NewtonSettings::default() };
-    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(reuse), settings);
+    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(reuse), settings());
     let mut u = vec![0.0; model.num_dofs()];
     let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
 
@@ -285,7 +296,7 @@ mod ordering_measurement {
     #[test]
     #[ignore]
     fn ordering_comparison() {
-        let sizes: Vec<usize> = std::env::var("STAMP_ORDERING_SIZES").unwrap_or("100,200".into()).split(',').map(|s| s.trim().parse().unwrap()).collect();
+        let sizes = sizes_from_env("STAMP_ORDERING_SIZES", "100,200");
         let numeric = std::env::var("STAMP_ORDERING_NUMERIC").map(|v| v != "0").unwrap_or(true);
         let par = faer::get_global_parallelism();
         println!("n | unknowns | nnz(A) | ordering | nnz(L) | flops | ordering s | symbolic s (incl. ordering) | numeric s (min of 3)");
@@ -335,14 +346,13 @@ mod ordering_measurement {
     #[ignore]
     fn ordering_bench() {
         use stamp::ldlt_gmres::Ordering;
-        let sizes: Vec<usize> = std::env::var("STAMP_ORDERING_SIZES").unwrap_or("100,200".into()).split(',').map(|s| s.trim().parse().unwrap()).collect();
+        let sizes = sizes_from_env("STAMP_ORDERING_SIZES", "100,200");
         println!("n | ordering | Newton | factorisations | GMRES | symbolic s | factor s | solve s | total s | centre deflection");
         for n in sizes {
             for ordering in [Ordering::Amd, Ordering::NestedDissection] {
                 let start = Instant::now();
                 let mut model = build(n).unwrap();
-                let settings = NewtonSettings { initial_increment: 0.1, max_increment: 1.0, line_search_steps: 4, ..NewtonSettings::default() };
-                let mut newton = NewtonRaphson::new(LdltGmres::new().ordering(ordering), settings);
+                let mut newton = NewtonRaphson::new(LdltGmres::new().ordering(ordering), settings());
                 let mut u = vec![0.0; model.num_dofs()];
                 let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
                 let st = newton.linear.timings();
@@ -372,7 +382,7 @@ mod assembly_measurement {
     #[test]
     #[ignore]
     fn assembly_threads() {
-        let sizes: Vec<usize> = std::env::var("STAMP_ASSEMBLY_SIZES").unwrap_or("200".into()).split(',').map(|s| s.trim().parse().unwrap()).collect();
+        let sizes = sizes_from_env("STAMP_ASSEMBLY_SIZES", "200");
         println!("n | unknowns | full assembly s, 1 thread | 2 threads | speed-up | residual only s, 2 threads (min of 5)");
         for n in sizes {
             let mut model = build(n).unwrap();
