@@ -66,9 +66,21 @@ impl Assembler {
 
     /// Evaluate all elements at the full dof vector `u`, add their internal forces into `force`
     /// (length = number of dofs, prescribed dofs included: those entries are reactions) and, if
-    /// `values` is given, their tangents into it (in `pattern`). Returns the total strain energy.
-    /// `force` and `values` are overwritten, not accumulated.
-    pub fn assemble<E: Element>(&self, element: &E, dofs: &DofMap, pattern: &SparsePattern, u: &[f64], force: &mut [f64], values: Option<&mut [f64]>) -> f64 {
+    /// `values` is given, their tangents into it (in `pattern`), and their preconditioner matrices
+    /// into `preconditioner` when that is given too (for elements with
+    /// [`Element::has_preconditioner`]). Returns the total strain energy. `force`, `values` and
+    /// `preconditioner` are overwritten, not accumulated.
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble<E: Element>(
+        &self,
+        element: &E,
+        dofs: &DofMap,
+        pattern: &SparsePattern,
+        u: &[f64],
+        force: &mut [f64],
+        values: Option<&mut [f64]>,
+        preconditioner: Option<&mut [f64]>,
+    ) -> f64 {
         let dpn = dofs.dofs_per_node();
         let npe = element.nodes_per_element();
         let nloc = dpn * npe;
@@ -76,7 +88,7 @@ impl Assembler {
         let parallel = element.num_elements() >= PARALLEL_MIN_ELEMENTS && rayon::current_num_threads() > 1;
         force.fill(0.0);
         let with_tangent = values.is_some();
-        let vals_ptr = match values {
+        let zeroed = |values: Option<&mut [f64]>| match values {
             Some(v) => {
                 if parallel {
                     v.par_iter_mut().for_each(|x| *x = 0.0);
@@ -87,10 +99,14 @@ impl Assembler {
             }
             None => SharedMut(std::ptr::null_mut()),
         };
+        let vals_ptr = zeroed(values);
+        let with_preconditioner = with_tangent && preconditioner.is_some() && element.has_preconditioner();
+        let pre_ptr = zeroed(if with_preconditioner { preconditioner } else { None });
         let force_ptr = SharedMut(force.as_mut_ptr());
         let eqs = dofs.equations();
         let mut energy = 0.0;
-        let init = || (element.new_workspace(), LocalSystem::new(nloc), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc]);
+        let local_system = || if with_preconditioner { LocalSystem::with_preconditioner(nloc) } else { LocalSystem::new(nloc) };
+        let init = || (element.new_workspace(), local_system(), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc]);
         // per-thread scratch: workspace, local system, local values, global dofs, row ranks
         let kernel = |st: &mut (E::Workspace, LocalSystem, Vec<f64>, Vec<usize>, Vec<u32>), e: usize| -> f64 {
                 let (ws, local, ue, gdof, rank) = st;
@@ -111,7 +127,7 @@ impl Assembler {
                         *fp.0.add(gdof[i]) += local.residual[i];
                     }
                     if with_tangent {
-                        let vp = vals_ptr;
+                        let (vp, pp) = (vals_ptr, pre_ptr);
                         // slot of (row dof i, column j) = column start + block offset of
                         // (node of i, node of j) + rank of i among its node's free dofs
                         for (a, r) in rank.iter_mut().enumerate() {
@@ -127,7 +143,11 @@ impl Assembler {
                                 let base = pattern.block_slot(e, a, b, ce as usize);
                                 for i in a * dpn..(a + 1) * dpn {
                                     if rank[i] != u32::MAX {
-                                        *vp.0.add(base + rank[i] as usize) += local.tangent[i * nloc + j];
+                                        let slot = base + rank[i] as usize;
+                                        *vp.0.add(slot) += local.tangent[i * nloc + j];
+                                        if with_preconditioner {
+                                            *pp.0.add(slot) += local.preconditioner[i * nloc + j];
+                                        }
                                     }
                                 }
                             }

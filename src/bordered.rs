@@ -34,6 +34,8 @@ pub struct BorderedSolver<S: LinearSolver = LdltGmres> {
     /// Position in the full value array of every entry of A11, in A11's order.
     map11: Vec<usize>,
     vals11: Vec<f64>,
+    /// The leading block of the preconditioner matrix, in A11's order.
+    pre11: Vec<f64>,
     /// (row, column k, position) of A12's entries (rows < n0, column n0 + k).
     a12: Vec<(usize, usize, usize)>,
     /// (row k, column, position) of A21's entries (row n0 + k, columns < n0).
@@ -66,6 +68,7 @@ impl<S: LinearSolver> BorderedSolver<S> {
             sym11: None,
             map11: Vec::new(),
             vals11: Vec::new(),
+            pre11: Vec::new(),
             a12: Vec::new(),
             a21: Vec::new(),
             a22: Vec::new(),
@@ -118,8 +121,17 @@ impl<S: LinearSolver> BorderedSolver<S> {
 
 impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
     fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
+        self.factorize_preconditioned(a, None)
+    }
+
+    fn uses_preconditioner(&self) -> bool {
+        self.inner.uses_preconditioner()
+    }
+
+    /// The leading block of `p` (A's pattern) preconditions the leading block of A.
+    fn factorize_preconditioned(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> Result<()> {
         if self.border == 0 {
-            return self.inner.factorize(a);
+            return self.inner.factorize_preconditioned(a, p);
         }
         if self.pattern_nnz != a.symbolic().row_idx().len() || self.sym11.is_none() {
             self.build_maps(a)?;
@@ -129,8 +141,18 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         for (v, &p) in self.vals11.iter_mut().zip(&self.map11) {
             *v = vals[p];
         }
-        let a11 = SparseColMatRef::new(self.sym11.as_ref().unwrap().as_ref(), &self.vals11);
-        self.inner.factorize(a11)?;
+        let sym11 = self.sym11.as_ref().unwrap().as_ref();
+        let a11 = SparseColMatRef::new(sym11, &self.vals11);
+        match p {
+            Some(p) if p.symbolic().row_idx().len() == self.pattern_nnz => {
+                let pv = p.val();
+                self.pre11.clear();
+                self.pre11.extend(self.map11.iter().map(|&k| pv[k]));
+                self.inner.factorize_preconditioned(a11, Some(SparseColMatRef::new(sym11, &self.pre11)))?;
+            }
+            Some(_) => return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into())),
+            None => self.inner.factorize(a11)?,
+        }
         // Y = A11^-1 A12
         self.y.clear();
         self.y.resize(n0 * m, 0.0);

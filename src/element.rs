@@ -3,18 +3,26 @@
 //! of an element; like fenris, it works in a caller-owned workspace so that the hot loop allocates
 //! nothing.
 
-/// The local result of one element: internal force vector, tangent matrix (row-major, square) and
-/// strain energy. Allocated once per thread and reused for every element.
+/// The local result of one element: internal force vector, tangent matrix (row-major, square),
+/// strain energy and, from elements with [`Element::has_preconditioner`], the local preconditioner
+/// matrix. Allocated once per thread and reused for every element.
 #[derive(Debug, Clone)]
 pub struct LocalSystem {
     pub residual: Vec<f64>,
     pub tangent: Vec<f64>,
+    /// Row-major and square like `tangent`, filled with it by elements that have a preconditioner;
+    /// empty (not asked for) unless made by [`LocalSystem::with_preconditioner`].
+    pub preconditioner: Vec<f64>,
     pub energy: f64,
 }
 
 impl LocalSystem {
     pub fn new(num_dofs: usize) -> Self {
-        LocalSystem { residual: vec![0.0; num_dofs], tangent: vec![0.0; num_dofs * num_dofs], energy: 0.0 }
+        LocalSystem { residual: vec![0.0; num_dofs], tangent: vec![0.0; num_dofs * num_dofs], preconditioner: Vec::new(), energy: 0.0 }
+    }
+    /// The same with room for the preconditioner matrix: asks the element to fill it.
+    pub fn with_preconditioner(num_dofs: usize) -> Self {
+        LocalSystem { preconditioner: vec![0.0; num_dofs * num_dofs], ..Self::new(num_dofs) }
     }
     pub fn num_dofs(&self) -> usize {
         self.residual.len()
@@ -23,6 +31,7 @@ impl LocalSystem {
     pub fn clear(&mut self) {
         self.residual.fill(0.0);
         self.tangent.fill(0.0);
+        self.preconditioner.fill(0.0);
         self.energy = 0.0;
     }
 }
@@ -44,10 +53,17 @@ pub trait Element: Sync {
     fn num_elements(&self) -> usize;
     /// Global node indices of element `e`.
     fn element_nodes(&self, e: usize) -> &[usize];
+    /// Whether `evaluate` also gives a symmetric matrix P close to a non-symmetric tangent, whose
+    /// factorisation preconditions the linear solves better than the tangent's symmetric part
+    /// (see [`crate::ldlt_gmres`]). Default: no.
+    fn has_preconditioner(&self) -> bool {
+        false
+    }
     /// A fresh workspace.
     fn new_workspace(&self) -> Self::Workspace;
     /// Evaluate element `e` at the local dof values `u`: fill `out.residual` (internal force), the
     /// strain energy and, when `with_tangent`, `out.tangent` = d residual / d u (not necessarily
-    /// symmetric). `out` is cleared by the caller.
+    /// symmetric), and with it `out.preconditioner` if [`Element::has_preconditioner`] and that is
+    /// not empty. `out` is cleared by the caller.
     fn evaluate(&self, e: usize, u: &[f64], ws: &mut Self::Workspace, out: &mut LocalSystem, with_tangent: bool);
 }

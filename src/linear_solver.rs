@@ -34,6 +34,17 @@ pub trait LinearSolver: Send {
     /// Factorise `a`. Implementations may reuse anything computed for an earlier matrix with the same
     /// pattern.
     fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()>;
+    /// Factorise `a`, given a symmetric matrix `p` of the same pattern close to it that an
+    /// iterative solver may factorise as its preconditioner instead (only its lower triangle need
+    /// be read). A direct solver ignores `p` (the default).
+    fn factorize_preconditioned(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> Result<()> {
+        let _ = p;
+        self.factorize(a)
+    }
+    /// Whether `factorize_preconditioned` makes use of `p` (so that it is worth building).
+    fn uses_preconditioner(&self) -> bool {
+        false
+    }
     /// Solve A x = b in place with the last factorisation.
     fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()>;
     /// Solve A x = b in place to a relative residual |b - A x| <= rtol |b| at least: an iterative

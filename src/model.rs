@@ -45,6 +45,9 @@ pub struct Model<E: Element> {
     /// Internal + contact force over all dofs at the last evaluation (reactions at prescribed dofs).
     force: Vec<f64>,
     values: Vec<f64>,
+    /// The preconditioner matrix in the same pattern (empty when the element has none or it was
+    /// not asked for, see [`NonlinearProblem::want_preconditioner`]).
+    preconditioner: Vec<f64>,
     residual: Vec<f64>,
     energy: f64,
     saved: Vec<(Vec<f64>, Vec<PointState>, Vec<bool>)>,
@@ -73,6 +76,7 @@ impl<E: Element> Model<E> {
         Ok(Model {
             force: vec![0.0; dofs.num_dofs()],
             values: vec![0.0; nnz],
+            preconditioner: Vec::new(),
             residual: vec![0.0; dofs.num_equations()],
             element,
             dofs,
@@ -146,6 +150,9 @@ impl<E: Element> Model<E> {
         self.force.resize(nd + nb, 0.0);
         self.residual.resize(self.dofs.num_equations() + nb, 0.0);
         self.values = vec![0.0; self.pattern.nnz()];
+        if !self.preconditioner.is_empty() {
+            self.preconditioner = vec![0.0; self.pattern.nnz()];
+        }
     }
 
     /// Strain energy at the last evaluation.
@@ -184,7 +191,8 @@ impl<E: Element> NonlinearProblem for Model<E> {
         }
         let start = Instant::now();
         let values = if with_tangent { Some(self.values.as_mut_slice()) } else { None };
-        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values);
+        let preconditioner = if with_tangent && !self.preconditioner.is_empty() { Some(self.preconditioner.as_mut_slice()) } else { None };
+        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values, preconditioner);
         self.force[nd..].fill(0.0);
         let internal_norm = self.force.iter().map(|x| x * x).sum::<f64>().sqrt();
         let t_contact = Instant::now();
@@ -197,11 +205,16 @@ impl<E: Element> NonlinearProblem for Model<E> {
             let pattern = &self.pattern;
             let dofs = &self.dofs;
             let values = &mut self.values;
+            let preconditioner = &mut self.preconditioner;
             let eq = |d: usize| if d < nd { dofs.equation(d) } else { Some(neq + d - nd) };
+            // the contact stiffness is symmetric: it belongs to the preconditioner as it is
             let mut add = |r: usize, c: usize, v: f64| {
                 if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
                     if let Some(s) = pattern.find(re, ce) {
                         values[s] += v;
+                        if let Some(p) = preconditioner.get_mut(s) {
+                            *p += v;
+                        }
                     }
                 }
             };
@@ -242,6 +255,16 @@ impl<E: Element> NonlinearProblem for Model<E> {
     }
     fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
         self.pattern.matrix(&self.values)
+    }
+    fn preconditioner(&self) -> Option<SparseColMatRef<'_, usize, f64>> {
+        (!self.preconditioner.is_empty()).then(|| self.pattern.matrix(&self.preconditioner))
+    }
+    /// Allocates (or frees) the preconditioner's values; the element must have one.
+    fn want_preconditioner(&mut self, on: bool) {
+        let on = on && self.element.has_preconditioner();
+        if on != !self.preconditioner.is_empty() {
+            self.preconditioner = if on { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
+        }
     }
     fn add_increment(&self, u: &mut [f64], du: &[f64]) {
         self.dofs.add_increment(u, du);

@@ -42,6 +42,14 @@ pub trait NonlinearProblem {
     fn residual(&self) -> &[f64];
     /// The tangent of the last evaluation with `with_tangent`.
     fn matrix(&self) -> SparseColMatRef<'_, usize, f64>;
+    /// A symmetric matrix of the same pattern close to the tangent, if the problem has one, for
+    /// [`LinearSolver::factorize_preconditioned`] (see [`crate::element::Element::has_preconditioner`]).
+    fn preconditioner(&self) -> Option<SparseColMatRef<'_, usize, f64>> {
+        None
+    }
+    /// Whether the evaluations with the tangent should also build the preconditioner (the
+    /// nonlinear solver says so when its linear solver uses one); off until asked.
+    fn want_preconditioner(&mut self, _on: bool) {}
     /// Add an increment given per equation.
     fn add_increment(&self, u: &mut [f64], du: &[f64]);
     /// Update any inequality constraints' active sets after Newton converged on them; returns the
@@ -317,7 +325,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                     p.evaluate(u, t, true).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
                     du.copy_from_slice(p.residual());
                 }
-                self.linear.factorize(p.matrix()).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
+                self.linear.factorize_preconditioned(p.matrix(), p.preconditioner()).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
                 factored = true;
                 // inexact Newton (Dembo, Eisenstat & Steihaug 1982; Eisenstat & Walker 1996): a
                 // linear residual of eta |R|, eta <= |R| / force scale, keeps the convergence
@@ -373,6 +381,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         on_step: &mut dyn FnMut(&StepReport, &[f64], &P),
     ) -> Result<SolveSummary> {
         let start = Instant::now();
+        p.want_preconditioner(self.linear.uses_preconditioner());
         let mut summary = SolveSummary::default();
         let mut t = t0;
         let mut trial = u.to_vec();

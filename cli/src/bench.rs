@@ -406,3 +406,49 @@ mod assembly_measurement {
         }
     }
 }
+
+#[cfg(test)]
+mod element_measurement {
+    //! Not a test: the plate element's kernel alone (no scatter), every element of the bench mesh
+    //! evaluated on one thread at a deformed state, tangent (and preconditioner) and residual only;
+    //! the minimum of 15 sweeps (ignored; run with
+    //! `STAMP_ELEMENT_SIZES=100 cargo test --release -p stamp-cli --lib element_kernel -- --ignored --nocapture`).
+    use super::*;
+    use stamp::element::{Element, LocalSystem};
+
+    #[test]
+    #[ignore]
+    fn element_kernel() {
+        for n in sizes_from_env("STAMP_ELEMENT_SIZES", "100") {
+            let model = build(n).unwrap();
+            let plate = &model.element;
+            let mut u = vec![0.0; model.num_dofs()];
+            for (k, x) in u.iter_mut().enumerate() {
+                *x = 1e-3 * ((k * 7919 % 1000) as f64 / 1000.0 - 0.5);
+            }
+            let mut ws = plate.new_workspace();
+            let mut out = LocalSystem::new(24);
+            let mut ue = [0.0; 24];
+            let mut sweep = |tangent: bool| {
+                (0..15)
+                    .map(|_| {
+                        let t = Instant::now();
+                        let mut check = 0.0;
+                        for e in 0..plate.num_elements() {
+                            for (a, &node) in plate.element_nodes(e).iter().enumerate() {
+                                ue[6 * a..6 * a + 6].copy_from_slice(&u[6 * node..6 * node + 6]);
+                            }
+                            out.clear();
+                            plate.evaluate(e, &ue, &mut ws, &mut out, tangent);
+                            check += out.tangent[25] + out.residual[3];
+                        }
+                        assert!(check.is_finite());
+                        t.elapsed().as_secs_f64() / plate.num_elements() as f64
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let (full, residual) = (sweep(true), sweep(false));
+            println!("n {n}: {} elements, microseconds per element: tangent {:.3}, residual only {:.3}", plate.num_elements(), 1e6 * full, 1e6 * residual);
+        }
+    }
+}

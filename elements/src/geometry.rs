@@ -54,16 +54,16 @@ pub struct ElementGeometry {
     pub frame: [[f64; 2]; 2],
     /// Shape functions at the Gauss points.
     pub n: [[f64; 4]; 4],
-    /// dN/dy_i (local Cartesian) at the Gauss points: dndy[g][node][i].
+    /// dN/dy_i (local Cartesian) at the Gauss points: `dndy[g][node][i]`.
     pub dndy: [[[f64; 2]; 4]; 4],
     /// Gauss weight times det J.
     pub wdet: [f64; 4],
-    /// J^-T at the Gauss points (maps covariant shear to local Cartesian): jit[g][i][a].
+    /// J^-T at the Gauss points (maps covariant shear to local Cartesian): `jit[g][i][a]`.
     pub jit: [[[f64; 2]; 2]; 4],
     pub line: [ShearPoint; 4],
     pub tying: [ShearPoint; 4],
     /// Projection weights of E11 (row average), E22 (column average), E12 (all four):
-    /// proj[kind][g][g'].
+    /// `proj[kind][g][g']`.
     pub proj: [[[f64; 4]; 4]; 3],
     /// Area of the element.
     pub area: f64,

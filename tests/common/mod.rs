@@ -42,7 +42,7 @@ pub fn steel_section(h: f64) -> Section {
 /// Evaluate element 0 of a plate at local dofs v.
 pub fn eval(plate: &PlateElements, v: &[f64], tangent: bool) -> LocalSystem {
     let mut ws = plate.new_workspace();
-    let mut out = LocalSystem::new(24);
+    let mut out = LocalSystem::with_preconditioner(24);
     plate.evaluate(0, v, &mut ws, &mut out, tangent);
     out
 }
