@@ -374,7 +374,7 @@ mod ordering_measurement {
 
 #[cfg(test)]
 mod assembly_measurement {
-    //! Not a test: one full assembly (residual and tangent) of the bench model with one and with
+    //! Not a test: one full assembly (residual, tangent and preconditioner) of the bench model with one and with
     //! two threads, and a residual-only one (ignored; run with
     //! `STAMP_ASSEMBLY_SIZES=200,400 cargo test --release -p stamp-cli --lib assembly_threads -- --ignored --nocapture`).
     use super::*;
@@ -386,6 +386,8 @@ mod assembly_measurement {
         println!("n | unknowns | full assembly s, 1 thread | 2 threads | speed-up | residual only s, 2 threads (min of 5)");
         for n in sizes {
             let mut model = build(n).unwrap();
+            // as in `stamp bench`: the tangent and the plate's preconditioner (LdltGmres uses it)
+            model.want_preconditioner(true);
             let mut u = vec![0.0; model.num_dofs()];
             model.apply_prescribed(&mut u, 0.3);
             let mut time = |threads: usize, tangent: bool| {
@@ -410,7 +412,7 @@ mod assembly_measurement {
 #[cfg(test)]
 mod element_measurement {
     //! Not a test: the plate element's kernel alone (no scatter), every element of the bench mesh
-    //! evaluated on one thread at a deformed state, tangent (and preconditioner) and residual only;
+    //! evaluated on one thread at a deformed state: tangent and preconditioner, tangent, residual only;
     //! the minimum of 15 sweeps (ignored; run with
     //! `STAMP_ELEMENT_SIZES=100 cargo test --release -p stamp-cli --lib element_kernel -- --ignored --nocapture`).
     use super::*;
@@ -427,9 +429,9 @@ mod element_measurement {
                 *x = 1e-3 * ((k * 7919 % 1000) as f64 / 1000.0 - 0.5);
             }
             let mut ws = plate.new_workspace();
-            let mut out = LocalSystem::new(24);
             let mut ue = [0.0; 24];
-            let mut sweep = |tangent: bool| {
+            let mut sweep = |tangent: bool, preconditioner: bool| {
+                let mut out = if preconditioner { LocalSystem::with_preconditioner(24) } else { LocalSystem::new(24) };
                 (0..15)
                     .map(|_| {
                         let t = Instant::now();
@@ -447,8 +449,14 @@ mod element_measurement {
                     })
                     .fold(f64::INFINITY, f64::min)
             };
-            let (full, residual) = (sweep(true), sweep(false));
-            println!("n {n}: {} elements, microseconds per element: tangent {:.3}, residual only {:.3}", plate.num_elements(), 1e6 * full, 1e6 * residual);
+            let (full, tangent, residual) = (sweep(true, true), sweep(true, false), sweep(false, false));
+            println!(
+                "n {n}: {} elements, microseconds per element: tangent and preconditioner {:.3}, tangent {:.3}, residual only {:.3}",
+                plate.num_elements(),
+                1e6 * full,
+                1e6 * tangent,
+                1e6 * residual
+            );
         }
     }
 }

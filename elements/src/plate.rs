@@ -58,6 +58,9 @@ const LINE: usize = 28; // + pt*2 + face: full covariant shear on the lines (par
 const TYING: usize = 36; // + pt*2 + face: full covariant shear at the edge midpoints (other quads)
 const NSAMPLE: usize = 44;
 const NQUAD: usize = 44; // samples with a Hessian (nonlinear kinematics)
+/// Per membrane strain kind (E11, E22, E12) and Gauss point, the first Gauss point of its
+/// projection group (same xi2, same xi1, all; see [`crate::geometry`]'s `proj`).
+const MEMBRANE_GROUP_FIRST: [[usize; 4]; 3] = [[0, 0, 2, 2], [0, 1, 1, 0], [0, 0, 0, 0]];
 /// Row of T33 (and E33) in D.
 const E33_ROW: usize = crate::material::idx::E33;
 
@@ -272,24 +275,37 @@ impl Element for PlateElements {
         // P asked for and different from the tangent
         let split = with_tangent && self.coupled && !out.preconditioner.is_empty();
         ws.mu = [0.0; NSAMPLE];
+        let mut strains = [[0.0; NSTRAIN]; 4];
+        let mut all_terms = [[([(0usize, 0.0); 8], 0usize); NSTRAIN]; 4];
         for g in 0..4 {
             let w = geo.wdet[g];
-            let mut strain = [0.0; NSTRAIN];
-            let rows = &mut ws.b[g * NSTRAIN..(g + 1) * NSTRAIN];
-            let mut terms = [([(0usize, 0.0); 8], 0usize); NSTRAIN];
             for c in 0..NSTRAIN {
-                terms[c] = Self::terms(geo, g, c);
-                let (t, n) = &terms[c];
-                let row = &mut rows[c];
+                // a membrane strain projected over a row, column or all of the Gauss points is the
+                // same at every point of its group: computed at the group's first point, copied
+                let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
+                if first < g {
+                    all_terms[g][c] = all_terms[first][c];
+                    strains[g][c] = strains[first][c];
+                    ws.b[g * NSTRAIN + c] = ws.b[first * NSTRAIN + c];
+                    continue;
+                }
+                all_terms[g][c] = Self::terms(geo, g, c);
+                let (t, n) = &all_terms[g][c];
+                let row = &mut ws.b[g * NSTRAIN + c];
                 *row = [0.0; NDOF];
+                let mut strain = 0.0;
                 for &(s, coef) in &t[..*n] {
                     let smp = &ws.samples[s];
-                    strain[c] += coef * smp.val;
+                    strain += coef * smp.val;
                     for (r, &gr) in row.iter_mut().zip(&smp.grad) {
                         *r += coef * gr;
                     }
                 }
+                strains[g][c] = strain;
             }
+            let strain = strains[g];
+            let terms = &all_terms[g];
+            let rows = &ws.b[g * NSTRAIN..(g + 1) * NSTRAIN];
             let mut stress = [0.0; NSTRAIN];
             for r in 0..NSTRAIN {
                 stress[r] = (0..NSTRAIN).map(|c| d[r][c] * strain[c]).sum();
@@ -342,35 +358,33 @@ impl Element for PlateElements {
         matmul(k, Accum::Add, b.transpose(), db, 1.0, Par::Seq);
         if split {
             out.preconditioner[..NDOF * NDOF].copy_from_slice(&out.tangent[..NDOF * NDOF]);
-            for g in 0..4 {
-                let (b33, coupling) = (&ws.b[g * NSTRAIN + E33_ROW], &ws.coupling[g]);
-                for (i, &bi) in b33.iter().enumerate() {
-                    if bi != 0.0 {
-                        for (kij, &cj) in out.tangent[i * NDOF..(i + 1) * NDOF].iter_mut().zip(coupling) {
-                            *kij += bi * cj;
-                        }
-                    }
-                }
-            }
+            // the rows dE33/dV of the four Gauss points: every NSTRAIN-th row of B
+            let b33 = MatRef::from_row_major_slice_with_stride(&ws.b.as_flattened()[E33_ROW * NDOF..], 4, NDOF, NSTRAIN * NDOF);
+            let coupling = MatRef::from_row_major_slice(ws.coupling.as_flattened(), 4, NDOF);
+            let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..NDOF * NDOF], NDOF, NDOF);
+            matmul(k, Accum::Add, b33.transpose(), coupling, 1.0, Par::Seq);
         }
         // geometric stiffness: sum_s mu_s Hess_s (x) I3, Hess_s = scale (a b^T + b a^T)
         if self.kinematics == Kinematics::Nonlinear {
-            let mut h = [[0.0; NPAIR]; NPAIR];
+            // X = sum_s mu_s scale_s a_s b_s^T, and H = X + X^T
+            let mut x = [[0.0; NPAIR]; NPAIR];
             for (smp, &m) in ws.samples[..NQUAD].iter().zip(&ws.mu[..NQUAD]) {
                 let f = m * smp.scale;
                 if f == 0.0 {
                     continue;
                 }
                 for kk in 0..NPAIR {
-                    let (fa, fb) = (f * smp.a[kk], f * smp.b[kk]);
-                    for l in 0..NPAIR {
-                        h[kk][l] += fa * smp.b[l] + fb * smp.a[l];
+                    let fa = f * smp.a[kk];
+                    if fa != 0.0 {
+                        for (xl, &bl) in x[kk].iter_mut().zip(&smp.b) {
+                            *xl += fa * bl;
+                        }
                     }
                 }
             }
             for kk in 0..NPAIR {
                 for l in 0..NPAIR {
-                    let val = h[kk][l];
+                    let val = x[kk][l] + x[l][kk];
                     for i in 0..3 {
                         out.tangent[(3 * kk + i) * NDOF + 3 * l + i] += val;
                     }
@@ -378,6 +392,30 @@ impl Element for PlateElements {
                         for i in 0..3 {
                             out.preconditioner[(3 * kk + i) * NDOF + 3 * l + i] += val;
                         }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The membrane rows shared between Gauss points (MEMBRANE_GROUP_FIRST) are those whose
+    /// projection weights are equal, on a distorted element where the weights all differ.
+    #[test]
+    fn membrane_groups_share_their_projection_weights() {
+        let geo = ElementGeometry::new(&[[0.0, 0.0], [2.0, 0.3], [2.6, 1.9], [-0.4, 1.2]], 0).unwrap();
+        for kind in 0..3 {
+            for g in 0..4 {
+                let first = MEMBRANE_GROUP_FIRST[kind][g];
+                assert_eq!(geo.proj[kind][g], geo.proj[kind][first], "kind {kind}, Gauss point {g}");
+                for h in 0..4 {
+                    // a point outside the group has different weights
+                    if MEMBRANE_GROUP_FIRST[kind][h] != first {
+                        assert_ne!(geo.proj[kind][g], geo.proj[kind][h], "kind {kind}, Gauss points {g} and {h}");
                     }
                 }
             }
