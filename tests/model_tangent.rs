@@ -112,6 +112,21 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
         let norm = x_lu.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let diff = x_lu.iter().zip(&x_b).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(diff < 1e-8 * norm, "bordered solve differs from the full LU by {diff:e} (|x| = {norm:e})");
+        // with the plate's preconditioner P (bordered like the tangent, symmetric, the contact and
+        // punch terms whole): the same solution
+        model.want_preconditioner(true);
+        model.evaluate(&u, 1.0, true).unwrap();
+        let p = model.preconditioner().expect("the plate gives P");
+        let pd = p.to_dense();
+        let asym = (0..neq).flat_map(|i| (0..neq).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max((pd[(i, j)] - pd[(j, i)]).abs()));
+        assert!(asym < 1e-10 * scale, "P is not symmetric: {asym:e}");
+        assert_eq!(pd[(s, s)], model.matrix().to_dense()[(s, s)], "the punch's own entry belongs to P whole");
+        let mut x_p = r.clone();
+        let mut b = stamp::bordered::BorderedSolver::new(1);
+        b.factorize_preconditioned(model.matrix(), Some(p)).unwrap();
+        b.solve_in_place(&mut x_p).unwrap();
+        let diff = x_lu.iter().zip(&x_p).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(diff < 1e-8 * norm, "bordered solve with P differs from the full LU by {diff:e} (|x| = {norm:e})");
     }
 }
 
