@@ -10,8 +10,9 @@
 //! the converse; SPEC section 2): its symmetric part S = (A + A^T) / 2 is a good preconditioner,
 //! GMRES on S^-1 converging by a decade every two iterations. Better still is a symmetric P that
 //! the problem may give with A ([`LinearSolver::factorize_preconditioned`]; the plate's is its
-//! tangent without that one-way coupling, see `Element::has_preconditioner`): then P is factorised
-//! instead of S, and GMRES needs about half the iterations (the coupling that P leaves out acts
+//! tangent without that one-way coupling, see `Element::has_preconditioner`): with
+//! [`LdltGmres::with_preconditioner`] (opt-in, see there why) P is factorised instead of S, and
+//! GMRES needs about half the iterations (the coupling that P leaves out acts
 //! one way only, so P^-1 A - I is close to nilpotent; measured on the sphere problem: 5 iterations
 //! instead of 15 to full accuracy, `tests/linear_solvers.rs`; 70-81 instead of 158-181 in all in
 //! `stamp bench` at n = 25-100). The framework does not know the plate: it measures the
@@ -162,6 +163,8 @@ pub struct LdltGmres {
     factored: bool,
     /// Reuse of the numeric factor across matrices of one pattern allowed.
     reuse: bool,
+    /// Factorise a given preconditioner matrix P instead of the symmetric part.
+    use_preconditioner: bool,
     /// The LDL^T factor holds a valid factorisation (of some earlier matrix if `stale`).
     factor_valid: bool,
     stale: bool,
@@ -209,6 +212,7 @@ impl LdltGmres {
             mode: Mode::Direct,
             factored: false,
             reuse: false,
+            use_preconditioner: false,
             factor_valid: false,
             stale: false,
             symmetric: false,
@@ -227,6 +231,17 @@ impl LdltGmres {
     /// Use a given parallelism for the factorisation and solves.
     pub fn with_parallelism(par: Par) -> Self {
         LdltGmres { par, ..Self::new() }
+    }
+
+    /// Factorise the symmetric matrix P a problem gives with A
+    /// ([`LinearSolver::factorize_preconditioned`]) instead of A's symmetric part (default: no).
+    /// Measured on the plate: half the GMRES iterations with the same answers up to 240 800
+    /// unknowns, but at 961 600 unknowns (`stamp bench`, n = 400) the different inexact solves
+    /// led Newton through the chaotic first contact to another equilibrium (reaction 650.65
+    /// instead of 577.23, README "Speed"); opt-in until first contact is made robust.
+    pub fn with_preconditioner(mut self, on: bool) -> Self {
+        self.use_preconditioner = on;
+        self
     }
 
     /// Allow or forbid (default) the reuse of a factor for later matrices of the same pattern.
@@ -462,11 +477,12 @@ impl LinearSolver for LdltGmres {
         self.factorize_preconditioned(a, None)
     }
 
-    /// As `factorize`, with `p` (when given and A is not symmetric) factorised as GMRES's
-    /// preconditioner in place of A's symmetric part. `p` must have A's pattern; its lower
+    /// As `factorize`, with `p` (when given, A is not symmetric and
+    /// [`LdltGmres::with_preconditioner`] is on) factorised as GMRES's preconditioner in place of
+    /// A's symmetric part. `p` must have A's pattern; its lower
     /// triangle is read.
     fn uses_preconditioner(&self) -> bool {
-        true
+        self.use_preconditioner
     }
 
     fn factorize_preconditioned(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> Result<()> {
@@ -497,7 +513,7 @@ impl LinearSolver for LdltGmres {
         }
         let size = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         self.symmetric = worst <= SYMMETRY_TOL * size;
-        if let (Some(p), false) = (p, self.symmetric) {
+        if let (Some(p), false, true) = (p, self.symmetric, self.use_preconditioner) {
             if p.symbolic().col_ptr() != self.col_ptr.as_slice() || p.symbolic().row_idx() != self.row_idx.as_slice() {
                 return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into()));
             }

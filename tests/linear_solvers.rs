@@ -127,8 +127,8 @@ fn plate_preconditioner_saves_gmres_iterations() {
     let pre = model.preconditioner().expect("the plate gives a preconditioner");
     let mut its = Vec::new();
     for with_p in [false, true] {
-        let mut fast = LdltGmres::new();
-        fast.factorize_preconditioned(model.matrix(), if with_p { Some(pre) } else { None }).unwrap();
+        let mut fast = LdltGmres::new().with_preconditioner(with_p);
+        fast.factorize_preconditioned(model.matrix(), Some(pre)).unwrap();
         let mut x = b.clone();
         fast.solve_in_place(&mut x).unwrap();
         let st = fast.stats();
@@ -140,7 +140,7 @@ fn plate_preconditioner_saves_gmres_iterations() {
     println!("GMRES iterations to full accuracy: symmetric part {}, P {}", its[0], its[1]);
     assert!(3 * its[1] <= 2 * its[0], "{its:?}");
     // the bordered solver without a border hands P on
-    let mut bordered = BorderedSolver::new(0);
+    let mut bordered = BorderedSolver::with_inner(0, LdltGmres::new().with_preconditioner(true));
     bordered.factorize_preconditioned(model.matrix(), Some(pre)).unwrap();
     let mut x = b.clone();
     bordered.solve_in_place(&mut x).unwrap();

@@ -122,7 +122,7 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
         assert!(asym < 1e-10 * scale, "P is not symmetric: {asym:e}");
         assert_eq!(pd[(s, s)], model.matrix().to_dense()[(s, s)], "the punch's own entry belongs to P whole");
         let mut x_p = r.clone();
-        let mut b = stamp::bordered::BorderedSolver::new(1);
+        let mut b = stamp::bordered::BorderedSolver::with_inner(1, stamp::ldlt_gmres::LdltGmres::new().with_preconditioner(true));
         b.factorize_preconditioned(model.matrix(), Some(p)).unwrap();
         b.solve_in_place(&mut x_p).unwrap();
         let diff = x_lu.iter().zip(&x_p).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));

@@ -122,13 +122,22 @@ pub fn peak_rss_bytes() -> u64 {
 
 /// Solve one size in this process and time it. The deformed plate of the last step is written as
 /// a .vtu file into a temporary folder (timed as output) and removed.
-pub fn run_one(n: usize, reuse: bool) -> Result<BenchRun> {
+/// The linear solver's options of a benchmark run.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SolverOptions {
+    /// `LdltGmres::reuse`.
+    pub reuse: bool,
+    /// `LdltGmres::with_preconditioner`.
+    pub preconditioner: bool,
+}
+
+pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
     if n == 0 {
         return Err(StampError::Problem("bench sizes must be positive".into()));
     }
     let start = Instant::now();
     let mut model = build(n)?;
-    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(reuse), settings());
+    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(options.reuse).with_preconditioner(options.preconditioner), settings());
     let mut u = vec![0.0; model.num_dofs()];
     let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
 
@@ -172,13 +181,14 @@ pub fn run_one(n: usize, reuse: bool) -> Result<BenchRun> {
 }
 
 /// Run every size in a child process (`<this program> bench --one n`) and collect the results.
-pub fn run_sizes(sizes: &[usize], reuse: bool, mut on_run: impl FnMut(&BenchRun)) -> Result<Vec<BenchRun>> {
+pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut(&BenchRun)) -> Result<Vec<BenchRun>> {
     let exe = std::env::current_exe().map_err(|e| StampError::io("the stamp program itself", e))?;
     let mut runs = Vec::new();
     for &n in sizes {
         let out = std::process::Command::new(&exe)
             .args(["bench", "--one", &n.to_string()])
-            .args(if reuse { &["--reuse"][..] } else { &[][..] })
+            .args(if options.reuse { &["--reuse"][..] } else { &[][..] })
+            .args(if options.preconditioner { &["--preconditioner"][..] } else { &[][..] })
             .output()
             .map_err(|e| StampError::io(&exe, e))?;
         if !out.status.success() {
@@ -225,22 +235,22 @@ pub fn row(r: &BenchRun) -> String {
 }
 
 /// `stamp bench`: all sizes, as a table or as JSON.
-pub fn bench_command(sizes: &[usize], json: bool, reuse: bool) -> Result<()> {
+pub fn bench_command(sizes: &[usize], json: bool, options: SolverOptions) -> Result<()> {
     if json {
-        let runs = run_sizes(sizes, reuse, |_| {})?;
+        let runs = run_sizes(sizes, options, |_| {})?;
         let text = serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).map_err(|e| StampError::Problem(e.to_string()))?;
         println!("{text}");
     } else {
         println!("{}", header());
-        run_sizes(sizes, reuse, |r| println!("{}", row(r)))?;
+        run_sizes(sizes, options, |r| println!("{}", row(r)))?;
         println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), gmres: GMRES iterations", rayon::current_num_threads());
     }
     Ok(())
 }
 
 /// `stamp bench --one n`: one size, as one JSON object on stdout.
-pub fn one_command(n: usize, reuse: bool) -> Result<()> {
-    let run = run_one(n, reuse)?;
+pub fn one_command(n: usize, options: SolverOptions) -> Result<()> {
+    let run = run_one(n, options)?;
     println!("{}", serde_json::to_string(&run).map_err(|e| StampError::Problem(e.to_string()))?);
     Ok(())
 }
@@ -374,7 +384,7 @@ mod ordering_measurement {
 
 #[cfg(test)]
 mod assembly_measurement {
-    //! Not a test: one full assembly (residual, tangent and preconditioner) of the bench model with one and with
+    //! Not a test: one full assembly (residual and tangent, and P with STAMP_ASSEMBLY_P set) of the bench model with one and with
     //! two threads, and a residual-only one (ignored; run with
     //! `STAMP_ASSEMBLY_SIZES=200,400 cargo test --release -p stamp-cli --lib assembly_threads -- --ignored --nocapture`).
     use super::*;
@@ -386,8 +396,9 @@ mod assembly_measurement {
         println!("n | unknowns | full assembly s, 1 thread | 2 threads | speed-up | residual only s, 2 threads (min of 5)");
         for n in sizes {
             let mut model = build(n).unwrap();
-            // as in `stamp bench`: the tangent and the plate's preconditioner (LdltGmres uses it)
-            model.want_preconditioner(true);
+            // with the plate's preconditioner P as well when STAMP_ASSEMBLY_P is set (as
+            // `stamp bench --preconditioner` assembles it)
+            model.want_preconditioner(std::env::var_os("STAMP_ASSEMBLY_P").is_some());
             let mut u = vec![0.0; model.num_dofs()];
             model.apply_prescribed(&mut u, 0.3);
             let mut time = |threads: usize, tangent: bool| {

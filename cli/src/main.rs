@@ -45,6 +45,11 @@ enum Command {
         /// cheaper than factorising again (default: factorise every iteration's matrix).
         #[arg(long)]
         reuse: bool,
+        /// Precondition GMRES with the LDL^T of the plate's P (its tangent without the one-way
+        /// thickness coupling) instead of the tangent's symmetric part: half the GMRES
+        /// iterations, but see README "Speed" (n = 400 then lands on another equilibrium).
+        #[arg(long)]
+        preconditioner: bool,
         /// Run one size in this process and print its JSON (used by `stamp bench` for each size).
         #[arg(long, hide = true)]
         one: Option<usize>,
@@ -57,8 +62,10 @@ fn main() -> ExitCode {
         None => stamp_cli::report::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::report::paper_command(json, plot.as_deref()),
         Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
-        Some(Command::Bench { one: Some(n), reuse, .. }) => stamp_cli::bench::one_command(n, reuse),
-        Some(Command::Bench { sizes, json, reuse, one: None }) => stamp_cli::bench::bench_command(&sizes, json, reuse),
+        Some(Command::Bench { one: Some(n), reuse, preconditioner, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, preconditioner }),
+        Some(Command::Bench { sizes, json, reuse, preconditioner, one: None }) => {
+            stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, preconditioner })
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
