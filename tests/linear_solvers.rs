@@ -20,12 +20,18 @@ fn deformed_tangent(n: usize, seed: u64) -> (stamp::model::Model<stamp_elements:
     let mut rng = common::Lcg(seed);
     let u: Vec<f64> = (0..model.num_dofs()).map(|_| 0.05 * (rng.next() - 0.5)).collect();
     model.evaluate(&u, 0.5, true).unwrap();
+    let (b, x_lu) = residual_and_lu_solution(&model);
+    (model, b, x_lu)
+}
+
+/// The residual of the model's last evaluation and the LU's solution of its tangent system.
+fn residual_and_lu_solution(model: &stamp::model::Model<stamp_elements::PlateElements>) -> (Vec<f64>, Vec<f64>) {
     let b = model.residual().to_vec();
     let mut lu = SparseLu::new();
     lu.factorize(model.matrix()).unwrap();
     let mut x_lu = b.clone();
     lu.solve_in_place(&mut x_lu).unwrap();
-    (model, b, x_lu)
+    (b, x_lu)
 }
 
 /// The tangent of a deformed, contacting plate: not symmetric (b_ab33 = 0), so the solver takes the
@@ -119,11 +125,7 @@ fn plate_preconditioner_saves_gmres_iterations() {
     assert!(model.preconditioner().is_none());
     model.want_preconditioner(true);
     model.evaluate(&u, 1.0, true).unwrap();
-    let b = model.residual().to_vec();
-    let mut lu = SparseLu::new();
-    lu.factorize(model.matrix()).unwrap();
-    let mut x_lu = b.clone();
-    lu.solve_in_place(&mut x_lu).unwrap();
+    let (b, x_lu) = residual_and_lu_solution(&model);
     let pre = model.preconditioner().expect("the plate gives a preconditioner");
     let mut its = Vec::new();
     for with_p in [false, true] {
