@@ -15,7 +15,7 @@
 //! GMRES needs about half the iterations (the coupling that P leaves out acts
 //! one way only, so P^-1 A - I is close to nilpotent; measured on the sphere problem: 5 iterations
 //! instead of 15 to full accuracy, `tests/linear_solvers.rs`; 70-81 instead of 158-181 in all in
-//! `stamp bench` at n = 25-100). The framework does not know the plate: it measures the
+//! `stamp bench --preconditioner` at n = 25-100). The framework does not know the plate: it measures the
 //! asymmetry of every matrix and chooses.
 //!
 //! - A symmetric to round-off: A = L D L^T, checked solve (backward error measured, up to two
