@@ -144,7 +144,7 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         let sym11 = self.sym11.as_ref().unwrap().as_ref();
         let a11 = SparseColMatRef::new(sym11, &self.vals11);
         match p {
-            Some(p) if p.symbolic().row_idx().len() == self.pattern_nnz => {
+            Some(p) if crate::sparse::same_pattern(p.symbolic(), a.symbolic()) => {
                 let pv = p.val();
                 self.pre11.clear();
                 self.pre11.extend(self.map11.iter().map(|&k| pv[k]));

@@ -514,7 +514,7 @@ impl LinearSolver for LdltGmres {
         let size = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         self.symmetric = worst <= SYMMETRY_TOL * size;
         if let (Some(p), false, true) = (p, self.symmetric, self.use_preconditioner) {
-            if p.symbolic().col_ptr() != self.col_ptr.as_slice() || p.symbolic().row_idx() != self.row_idx.as_slice() {
+            if !crate::sparse::same_pattern(p.symbolic(), a.symbolic()) {
                 return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into()));
             }
             self.symmetric_values.copy_from_slice(p.val());

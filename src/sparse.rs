@@ -8,7 +8,7 @@
 
 use crate::dofs::{DofMap, PRESCRIBED};
 use crate::error::{Result, StampError};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 /// The compressed-column pattern of the global matrix and the element-to-slot maps.
 #[derive(Clone)]
@@ -233,6 +233,13 @@ impl SparsePattern {
     pub fn rank(&self, dof: usize) -> u32 {
         self.rank[dof] as u32
     }
+}
+
+/// Whether two compressed-column patterns are the same: the same arrays (a tangent and the
+/// preconditioner a model builds in one pattern, found at once) or equal ones.
+pub fn same_pattern(a: SymbolicSparseColMatRef<'_, usize>, b: SymbolicSparseColMatRef<'_, usize>) -> bool {
+    let same = |x: &[usize], y: &[usize]| std::ptr::eq(x, y) || x == y;
+    a.nrows() == b.nrows() && same(a.col_ptr(), b.col_ptr()) && same(a.row_idx(), b.row_idx())
 }
 
 /// Pair every stored entry (i, j) of a compressed-column pattern with the position of (j, i):

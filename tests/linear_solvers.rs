@@ -148,3 +148,31 @@ fn plate_preconditioner_saves_gmres_iterations() {
     bordered.solve_in_place(&mut x).unwrap();
     assert!(relative_difference(&x_lu, &x) < 1e-8);
 }
+
+/// A preconditioner matrix whose pattern is not the matrix's is refused with an error, by the
+/// LDL^T solver and by the bordered one; the same pattern in other arrays is accepted.
+#[test]
+fn preconditioner_of_another_pattern_is_refused() {
+    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    use stamp::bordered::BorderedSolver;
+    let (mut model, _, _) = deformed_tangent(4, 3);
+    model.want_preconditioner(true);
+    let u = vec![0.0; model.num_dofs()];
+    model.evaluate(&u, 0.5, true).unwrap();
+    let (a, p) = (model.matrix(), model.preconditioner().unwrap());
+    let n = a.nrows();
+    // the same pattern in copied arrays: accepted
+    let (cp, ri) = (p.symbolic().col_ptr().to_vec(), p.symbolic().row_idx().to_vec());
+    let copy = SparseColMatRef::new(SymbolicSparseColMatRef::new_checked(n, n, &cp, None, &ri), p.val());
+    LdltGmres::new().with_preconditioner(true).factorize_preconditioned(a, Some(copy)).unwrap();
+    // the diagonal only: refused
+    let diag_cp: Vec<usize> = (0..=n).collect();
+    let diag_ri: Vec<usize> = (0..n).collect();
+    let ones = vec![1.0; n];
+    let diagonal = SparseColMatRef::new(SymbolicSparseColMatRef::new_checked(n, n, &diag_cp, None, &diag_ri), &ones);
+    let e = LdltGmres::new().with_preconditioner(true).factorize_preconditioned(a, Some(diagonal)).unwrap_err();
+    assert!(e.to_string().contains("preconditioner's pattern"), "{e}");
+    // and so does the bordered solver
+    let e = BorderedSolver::with_inner(1, LdltGmres::new().with_preconditioner(true)).factorize_preconditioned(a, Some(diagonal)).unwrap_err();
+    assert!(e.to_string().contains("preconditioner's pattern"), "{e}");
+}
