@@ -6,6 +6,7 @@
 
 use crate::dofs::DofMap;
 use crate::element::{Element, LocalSystem};
+use crate::error::{Result, StampError};
 use crate::sparse::SparsePattern;
 use rayon::prelude::*;
 
@@ -68,7 +69,9 @@ impl Assembler {
     /// (length = number of dofs, prescribed dofs included: those entries are reactions) and, if
     /// `values` is given, their tangents into it (in `pattern`), and their preconditioner matrices
     /// into `preconditioner` when that is given too (for elements with
-    /// [`Element::has_preconditioner`]). Returns the total strain energy. `force`, `values` and
+    /// [`Element::has_preconditioner`]). Returns the total strain energy, or
+    /// [`StampError::Inadmissible`] naming the lowest-numbered element that refused the state
+    /// ([`LocalSystem::inadmissible`]; the arrays are then not meaningful). `force`, `values` and
     /// `preconditioner` are overwritten, not accumulated.
     #[allow(clippy::too_many_arguments)]
     pub fn assemble<E: Element>(
@@ -80,7 +83,7 @@ impl Assembler {
         force: &mut [f64],
         values: Option<&mut [f64]>,
         preconditioner: Option<&mut [f64]>,
-    ) -> f64 {
+    ) -> Result<f64> {
         let dpn = dofs.dofs_per_node();
         let npe = element.nodes_per_element();
         let nloc = dpn * npe;
@@ -108,7 +111,8 @@ impl Assembler {
         let local_system = || if with_preconditioner { LocalSystem::with_preconditioner(nloc) } else { LocalSystem::new(nloc) };
         let init = || (element.new_workspace(), local_system(), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc]);
         // per-thread scratch: workspace, local system, local values, global dofs, row ranks
-        let kernel = |st: &mut (E::Workspace, LocalSystem, Vec<f64>, Vec<usize>, Vec<u32>), e: usize| -> f64 {
+        // per element: its energy, and its number if it refused the state (usize::MAX if not)
+        let kernel = |st: &mut (E::Workspace, LocalSystem, Vec<f64>, Vec<usize>, Vec<u32>), e: usize| -> (f64, usize) {
                 let (ws, local, ue, gdof, rank) = st;
                 let nodes = element.element_nodes(e);
                 for (a, &n) in nodes.iter().enumerate() {
@@ -119,6 +123,9 @@ impl Assembler {
                 }
                 local.clear();
                 element.evaluate(e, ue, ws, local, with_tangent);
+                if local.inadmissible.is_some() {
+                    return (0.0, e);
+                }
                 // SAFETY: elements of one colour share no node, so they write disjoint
                 // entries of `force` and of the value array.
                 unsafe {
@@ -154,20 +161,37 @@ impl Assembler {
                         }
                     }
                 }
-                local.energy
+                (local.energy, usize::MAX)
             };
+        let mut refused = usize::MAX;
         if !parallel {
             let mut state = init();
             for color in &self.colors {
                 for &e in color {
-                    energy += kernel(&mut state, e);
+                    let (w, bad) = kernel(&mut state, e);
+                    energy += w;
+                    refused = refused.min(bad);
                 }
             }
-            return energy;
+        } else {
+            for color in &self.colors {
+                let (w, bad) = color
+                    .par_iter()
+                    .with_min_len(256)
+                    .map_init(init, |st, &e| kernel(st, e))
+                    .reduce(|| (0.0, usize::MAX), |a, b| (a.0 + b.0, a.1.min(b.1)));
+                energy += w;
+                refused = refused.min(bad);
+            }
         }
-        for color in &self.colors {
-            energy += color.par_iter().with_min_len(256).map_init(init, |st, &e| kernel(st, e)).sum::<f64>();
+        if refused == usize::MAX {
+            return Ok(energy);
         }
-        energy
+        // the reason, from the element itself
+        let mut local = LocalSystem::new(nloc);
+        let ue: Vec<f64> = element.element_nodes(refused).iter().flat_map(|&n| (0..dpn).map(move |c| u[n * dpn + c])).collect();
+        element.evaluate(refused, &ue, &mut element.new_workspace(), &mut local, false);
+        let reason = local.inadmissible.unwrap_or_else(|| "refused (no reason given)".into());
+        Err(StampError::Inadmissible { element: refused, reason })
     }
 }

@@ -14,11 +14,15 @@ pub struct LocalSystem {
     /// empty (not asked for) unless made by [`LocalSystem::with_preconditioner`].
     pub preconditioner: Vec<f64>,
     pub energy: f64,
+    /// Set by the element when the state it was evaluated at is not physically admissible (a
+    /// finite-strain element turned inside out, say), with the reason: the assembler then refuses
+    /// the whole state, naming the element, and Newton's line search or load stepping backs off.
+    pub inadmissible: Option<String>,
 }
 
 impl LocalSystem {
     pub fn new(num_dofs: usize) -> Self {
-        LocalSystem { residual: vec![0.0; num_dofs], tangent: vec![0.0; num_dofs * num_dofs], preconditioner: Vec::new(), energy: 0.0 }
+        LocalSystem { residual: vec![0.0; num_dofs], tangent: vec![0.0; num_dofs * num_dofs], preconditioner: Vec::new(), energy: 0.0, inadmissible: None }
     }
     /// The same with room for the preconditioner matrix: asks the element to fill it.
     pub fn with_preconditioner(num_dofs: usize) -> Self {
@@ -33,6 +37,7 @@ impl LocalSystem {
         self.tangent.fill(0.0);
         self.preconditioner.fill(0.0);
         self.energy = 0.0;
+        self.inadmissible = None;
     }
 }
 
@@ -64,6 +69,7 @@ pub trait Element: Sync {
     /// Evaluate element `e` at the local dof values `u`: fill `out.residual` (internal force), the
     /// strain energy and, when `with_tangent`, `out.tangent` = d residual / d u (not necessarily
     /// symmetric), and with it `out.preconditioner` if [`Element::has_preconditioner`] and that is
-    /// not empty. `out` is cleared by the caller.
+    /// not empty; and `out.inadmissible` with the reason if the state `u` is not admissible (the
+    /// residual then need not be meaningful). `out` is cleared by the caller.
     fn evaluate(&self, e: usize, u: &[f64], ws: &mut Self::Workspace, out: &mut LocalSystem, with_tangent: bool);
 }

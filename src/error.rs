@@ -24,6 +24,10 @@ pub enum StampError {
     /// A NaN or infinity appeared where a finite number was required.
     #[error("non-finite value: {0}")]
     NonFinite(String),
+    /// An element refused the state it was evaluated at (see
+    /// [`crate::element::LocalSystem::inadmissible`]).
+    #[error("element {element} is in an inadmissible state: {reason}")]
+    Inadmissible { element: usize, reason: String },
     /// The sparse factorisation failed (singular or structurally deficient matrix).
     #[error("linear solver failed: {0}")]
     LinearSolver(String),

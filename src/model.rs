@@ -192,7 +192,7 @@ impl<E: Element> NonlinearProblem for Model<E> {
         let start = Instant::now();
         let values = if with_tangent { Some(self.values.as_mut_slice()) } else { None };
         let preconditioner = if with_tangent && !self.preconditioner.is_empty() { Some(self.preconditioner.as_mut_slice()) } else { None };
-        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values, preconditioner);
+        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values, preconditioner)?;
         self.force[nd..].fill(0.0);
         let internal_norm = self.force.iter().map(|x| x * x).sum::<f64>().sqrt();
         let t_contact = Instant::now();

@@ -62,3 +62,84 @@ fn the_linear_variant_is_not_rigid_body_exact_for_large_rotations() {
     let out = eval(&plate, &v, false);
     assert!(max_abs(&out.residual) > 1.0);
 }
+
+/// Rigid motions keep the volume ratio det[g1, g2, g3] / det[G1, G2, G3] at 1; mirror images have
+/// the same (zero) Green-Lagrange strains but a volume ratio of -1, and the nonlinear element
+/// refuses them (the assembler then refuses the state, Newton backs off).
+#[test]
+fn mirror_images_are_strain_free_but_refused() {
+    let mesh = distorted_element();
+    let h = 0.1;
+    let plate = plate(&mesh, h, Kinematics::Nonlinear);
+    let mut ws = stamp::element::Element::new_workspace(&plate);
+    let mut rng = Lcg(11);
+    let pi = std::f64::consts::PI;
+    let mirrors = [[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]], [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]];
+    for _ in 0..10 {
+        let rot = euler_krylov(rng.range(-pi, pi), rng.range(-pi, pi), rng.range(-pi, pi));
+        let shift = [rng.range(-5.0, 5.0), rng.range(-5.0, 5.0), rng.range(-5.0, 5.0)];
+        let v = rigid_dofs(&mesh, h, rot, shift);
+        let j = plate.smallest_volume_ratio(0, &v, &mut ws);
+        assert!((j - 1.0).abs() <= 1e-12, "rotation: volume ratio {j}");
+        assert!(eval(&plate, &v, true).inadmissible.is_none());
+        for m in mirrors {
+            // the rotation after the mirror: still an improper orthogonal map
+            let mut q = [[0.0; 3]; 3];
+            for i in 0..3 {
+                for k in 0..3 {
+                    q[i][k] = (0..3).map(|l| rot[i][l] * m[l][k]).sum();
+                }
+            }
+            let v = rigid_dofs(&mesh, h, q, shift);
+            let state = plate.gauss_state(0, &v, &mut ws);
+            for g in 0..4 {
+                assert!(max_abs(&state.strain[g]) <= 1e-12, "a mirror image strains: {:?}", state.strain[g]);
+            }
+            let j = plate.smallest_volume_ratio(0, &v, &mut ws);
+            assert!((j + 1.0).abs() <= 1e-12, "mirror: volume ratio {j}");
+            let out = eval(&plate, &v, true);
+            let reason = out.inadmissible.expect("a mirror image must be refused");
+            assert!(reason.contains("inside out"), "{reason}");
+        }
+    }
+    // the linear theory has no such limit
+    let linear = common::plate(&mesh, h, Kinematics::Linear);
+    let v = rigid_dofs(&mesh, h, mirrors[0], [0.0; 3]);
+    assert!(eval(&linear, &v, true).inadmissible.is_none());
+}
+
+/// One fibre pushed through the plate (the top face of a corner node below its bottom face): the
+/// model's evaluation fails with an error naming the one element that holds that node, and the
+/// same state with the fibre only shortened is evaluated.
+#[test]
+fn a_fibre_pushed_through_the_plate_is_refused_naming_its_element() {
+    use stamp::nonlinear::NonlinearProblem;
+    use stamp_elements::Face;
+    let mesh = stamp::mesh::QuadMesh::rectangle(0.0, 3.0, 0.0, 2.0, 3, 2).unwrap();
+    let h = 0.1;
+    let plate = plate(&mesh, h, Kinematics::Nonlinear);
+    let dofs = stamp::dofs::DofMap::new(mesh.num_nodes(), 6).unwrap();
+    let mut model = stamp::model::Model::new(plate, dofs).unwrap();
+    // the last node: a corner, in the last cell only
+    let node = mesh.num_nodes() - 1;
+    let cell = mesh.cells.iter().position(|c| c.contains(&node)).unwrap();
+    assert_eq!(mesh.cells.iter().filter(|c| c.contains(&node)).count(), 1);
+    let mut u = vec![0.0; model.num_dofs()];
+    for (factor, refused) in [(0.5, false), (1.5, false), (3.0, true)] {
+        // the node's fibre e3 (1 - factor): flipped when factor > 1, but the element samples its
+        // fibres at the Gauss points: at the one nearest the node the fibre is e3 (1 - 0.622 factor)
+        // (0.622 the node's shape function there), flipped once factor > 1.61
+        u[Face::Top.dof(node, 2)] = -0.5 * h * factor;
+        u[Face::Bottom.dof(node, 2)] = 0.5 * h * factor;
+        match model.evaluate(&u, 0.0, true) {
+            Ok(ev) => assert!(!refused && ev.residual_norm.is_finite() && ev.residual_norm > 0.0),
+            Err(stamp::StampError::Inadmissible { element, reason }) => {
+                assert!(refused, "refused a shortened fibre: {reason}");
+                assert_eq!(element, cell);
+                let message = stamp::StampError::Inadmissible { element, reason }.to_string();
+                assert!(message.contains(&format!("element {cell}")) && message.contains("inside out"), "{message}");
+            }
+            Err(e) => panic!("unexpected error {e}"),
+        }
+    }
+}

@@ -1,5 +1,5 @@
 //! The assembled tangent of a whole model (plate elements plus contact with a curved punch) is the
-//! derivative of its residual: compared with central finite differences at a random
+//! derivative of its residual: compared with central finite differences at a random (admissible)
 //! large-displacement state with many points in contact, with the punch moved by a prescribed
 //! displacement or pressed by a force (its displacement then an unknown with its own equation).
 
@@ -58,7 +58,16 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
     model.add_contact(pair);
     assert_eq!(model.num_dofs(), model.dofs.num_dofs() + drive.is_some() as usize);
     assert_eq!(model.num_equations(), model.dofs.num_equations() + drive.is_some() as usize);
+    // large deflections (+-0.3, the thickness 0.2), in-plane displacements of +-0.1 and the faces
+    // close to each other (+-0.03): admissible (no element turned inside out)
     let mut u: Vec<f64> = (0..model.num_dofs()).map(|_| rng.range(-0.3, 0.3)).collect();
+    for n in 0..mesh.num_nodes() {
+        for c in 0..3 {
+            let amplitude = if c == 2 { 1.0 } else { 1.0 / 3.0 };
+            u[Face::Top.dof(n, c)] *= amplitude;
+            u[Face::Bottom.dof(n, c)] = u[Face::Top.dof(n, c)] + 0.1 * u[Face::Bottom.dof(n, c)];
+        }
+    }
     model.apply_prescribed(&mut u, 1.0);
     model.evaluate(&u, 1.0, true).unwrap();
     let active = model.contacts[0].state.iter().filter(|s| s.active).count();

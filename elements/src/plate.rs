@@ -64,6 +64,11 @@ const MEMBRANE_GROUP_FIRST: [[usize; 4]; 3] = [[0, 0, 2, 2], [0, 1, 1, 0], [0, 0
 /// Row of T33 (and E33) in D.
 const E33_ROW: usize = crate::material::idx::E33;
 
+/// a . (b x c)
+fn triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
+    a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
+}
+
 /// Per-thread scratch memory of the plate element.
 pub struct PlateWorkspace {
     samples: Box<[Sample; NSAMPLE]>,
@@ -75,6 +80,9 @@ pub struct PlateWorkspace {
     /// tangent's one-way coupling (b_ab33 = 0, b_33ab != 0).
     coupling: [[f64; NDOF]; 4],
     mu: [f64; NSAMPLE],
+    /// The smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] of the faces at the Gauss
+    /// points found by the last `compute_samples` (see [`PlateElements::smallest_volume_ratio`]).
+    volume_ratio: f64,
 }
 
 /// The assumed strains and resultants at the element's Gauss points.
@@ -191,6 +199,9 @@ impl PlateElements {
                 s[id].linear(scale, a, b)
             }
         };
+        // the reference frame's orientation: det[G1, G2, G3] with G3 = e3
+        let reference = geo.frame[0][0] * geo.frame[1][1] - geo.frame[0][1] * geo.frame[1][0];
+        let mut volume_ratio = f64::INFINITY;
         for g in 0..4 {
             let g3 = fibre(&geo.n[g]);
             put(E33 + g, 0.5, &g3, &g3, true);
@@ -198,12 +209,14 @@ impl PlateElements {
                 let dn = |i: usize| [geo.dndy[g][0][i], geo.dndy[g][1][i], geo.dndy[g][2][i], geo.dndy[g][3][i]];
                 let g1 = tangent(geo.frame[0], dn(0), face);
                 let g2 = tangent(geo.frame[1], dn(1), face);
+                volume_ratio = volume_ratio.min(triple(&g1.g, &g2.g, &g3.g) / reference);
                 let base = MEM + g * 6 + face * 3;
                 put(base, 0.5, &g1, &g1, true);
                 put(base + 1, 0.5, &g2, &g2, true);
                 put(base + 2, 1.0, &g1, &g2, true);
             }
         }
+        ws.volume_ratio = volume_ratio;
         for pt in 0..4 {
             // only the shear samples this element's interpolation uses (see terms())
             let sp = if geo.parallelogram { &geo.line[pt] } else { &geo.tying[pt] };
@@ -214,6 +227,17 @@ impl PlateElements {
                 put(base + pt * 2 + face, 1.0, &gt, &g3, true);
             }
         }
+    }
+
+    /// The smallest volume ratio J = det[g1, g2, g3] / det[G1, G2, G3] over both faces at the four
+    /// Gauss points of element `e` at local dofs `v` (g_a the deformed face tangents, g3 the
+    /// deformed fibre (eq. 1.4); 1 in the reference state and under any rigid motion). J <= 0
+    /// means that the element turned inside out: a fibre passed through its face, or a face
+    /// folded over. Green-Lagrange strains cannot see this (a mirror image has the same strains),
+    /// so the nonlinear element refuses such states ([`LocalSystem::inadmissible`]).
+    pub fn smallest_volume_ratio(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace) -> f64 {
+        self.compute_samples(e, v, ws);
+        ws.volume_ratio
     }
 
     /// Assumed strains and stress resultants at the Gauss points of element `e` for local dofs `v`
@@ -265,11 +289,21 @@ impl Element for PlateElements {
             db: [[0.0; NDOF]; 4 * NSTRAIN],
             coupling: [[0.0; NDOF]; 4],
             mu: [0.0; NSAMPLE],
+            volume_ratio: 1.0,
         }
     }
 
+    /// The nonlinear element refuses a state in which it turned inside out (see
+    /// [`PlateElements::smallest_volume_ratio`]; it still computes the residual and tangent there,
+    /// which the tangent tests use); the linear theory has no such limit.
     fn evaluate(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
         self.compute_samples(e, v, ws);
+        if self.kinematics == Kinematics::Nonlinear && ws.volume_ratio <= 0.0 {
+            out.inadmissible = Some(format!(
+                "it turned inside out (smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] of a face at a Gauss point: {:.3e})",
+                ws.volume_ratio
+            ));
+        }
         let geo = &self.geometry[e];
         let d = &self.d;
         // P asked for and different from the tangent
