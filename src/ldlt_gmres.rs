@@ -10,13 +10,13 @@
 //! the converse; SPEC section 2): its symmetric part S = (A + A^T) / 2 is a good preconditioner,
 //! GMRES on S^-1 converging by a decade every two iterations. Better still is a symmetric P that
 //! the problem may give with A ([`LinearSolver::factorize_preconditioned`]; the plate's is its
-//! tangent without that one-way coupling, see `Element::has_preconditioner`): with
-//! [`LdltGmres::with_preconditioner`] (opt-in, see there why) P is factorised instead of S, and
-//! GMRES needs about half the iterations (the coupling that P leaves out acts
-//! one way only, so P^-1 A - I is close to nilpotent; measured on the sphere problem: 5 iterations
-//! instead of 15 to full accuracy, `tests/linear_solvers.rs`; 70-81 instead of 158-181 in all in
-//! `stamp bench --preconditioner` at n = 25-100). The framework does not know the plate: it measures the
-//! asymmetry of every matrix and chooses.
+//! tangent without that one-way coupling, see `Element::has_preconditioner`): when given, P is
+//! factorised instead of S (the default, [`LdltGmres::with_preconditioner`]), and GMRES needs
+//! about half the iterations (the coupling that P leaves out acts one way only, so P^-1 A - I is
+//! close to nilpotent; measured on the sphere problem: 5 iterations instead of 15 to full
+//! accuracy, `tests/linear_solvers.rs`; in `stamp bench` about half the iterations at every size,
+//! README "Speed"). The framework does not know the plate: it measures the asymmetry of every
+//! matrix and chooses.
 //!
 //! - A symmetric to round-off: A = L D L^T, checked solve (backward error measured, up to two
 //!   steps of iterative refinement).
@@ -212,7 +212,7 @@ impl LdltGmres {
             mode: Mode::Direct,
             factored: false,
             reuse: false,
-            use_preconditioner: false,
+            use_preconditioner: true,
             factor_valid: false,
             stale: false,
             symmetric: false,
@@ -234,11 +234,10 @@ impl LdltGmres {
     }
 
     /// Factorise the symmetric matrix P a problem gives with A
-    /// ([`LinearSolver::factorize_preconditioned`]) instead of A's symmetric part (default: no).
-    /// Measured on the plate: half the GMRES iterations with the same answers up to 240 800
-    /// unknowns, but at 961 600 unknowns (`stamp bench`, n = 400) the different inexact solves
-    /// led Newton through the chaotic first contact to another equilibrium (reaction 650.65
-    /// instead of 577.23, README "Speed"); opt-in until first contact is made robust.
+    /// ([`LinearSolver::factorize_preconditioned`]) instead of A's symmetric part (default: yes).
+    /// Measured on the plate (`stamp bench`): half the GMRES iterations at every size, the same
+    /// answers, and a third less time at n = 400 (README "Speed"). `false` factorises the
+    /// symmetric part whatever the problem gives.
     pub fn with_preconditioner(mut self, on: bool) -> Self {
         self.use_preconditioner = on;
         self

@@ -127,8 +127,9 @@ pub fn peak_rss_bytes() -> u64 {
 pub struct SolverOptions {
     /// `LdltGmres::reuse`.
     pub reuse: bool,
-    /// `LdltGmres::with_preconditioner`.
-    pub preconditioner: bool,
+    /// Factorise the tangent's symmetric part instead of the plate's P
+    /// (`LdltGmres::with_preconditioner(false)`).
+    pub symmetric_part: bool,
 }
 
 pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
@@ -137,7 +138,7 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
     }
     let start = Instant::now();
     let mut model = build(n)?;
-    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(options.reuse).with_preconditioner(options.preconditioner), settings());
+    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(options.reuse).with_preconditioner(!options.symmetric_part), settings());
     let mut u = vec![0.0; model.num_dofs()];
     let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
 
@@ -188,7 +189,7 @@ pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut
         let out = std::process::Command::new(&exe)
             .args(["bench", "--one", &n.to_string()])
             .args(if options.reuse { &["--reuse"][..] } else { &[][..] })
-            .args(if options.preconditioner { &["--preconditioner"][..] } else { &[][..] })
+            .args(if options.symmetric_part { &["--symmetric-part"][..] } else { &[][..] })
             .output()
             .map_err(|e| StampError::io(&exe, e))?;
         if !out.status.success() {
@@ -384,7 +385,7 @@ mod ordering_measurement {
 
 #[cfg(test)]
 mod assembly_measurement {
-    //! Not a test: one full assembly (residual and tangent, and P with STAMP_ASSEMBLY_P set) of the bench model with one and with
+    //! Not a test: one full assembly (residual, tangent and P; no P with STAMP_ASSEMBLY_SYMMETRIC set) of the bench model with one and with
     //! two threads, and a residual-only one (ignored; run with
     //! `STAMP_ASSEMBLY_SIZES=200,400 cargo test --release -p stamp-cli --lib assembly_threads -- --ignored --nocapture`).
     use super::*;
@@ -396,9 +397,9 @@ mod assembly_measurement {
         println!("n | unknowns | full assembly s, 1 thread | 2 threads | speed-up | residual only s, 2 threads (min of 5)");
         for n in sizes {
             let mut model = build(n).unwrap();
-            // with the plate's preconditioner P as well when STAMP_ASSEMBLY_P is set (as
-            // `stamp bench --preconditioner` assembles it)
-            model.want_preconditioner(std::env::var_os("STAMP_ASSEMBLY_P").is_some());
+            // with the plate's preconditioner P, as `stamp bench` assembles it; without it when
+            // STAMP_ASSEMBLY_SYMMETRIC is set (as `stamp bench --symmetric-part`)
+            model.want_preconditioner(std::env::var_os("STAMP_ASSEMBLY_SYMMETRIC").is_none());
             let mut u = vec![0.0; model.num_dofs()];
             model.apply_prescribed(&mut u, 0.3);
             let mut time = |threads: usize, tangent: bool| {
