@@ -144,7 +144,9 @@ pub struct LdltGmres {
     ordering: Ordering,
     ordering_used: Option<Ordering>,
     factor: Vec<f64>,
-    /// Pattern and values of the last matrix A, and the values of its symmetric part.
+    /// Pattern of the last matrix A; its values in that pattern only when the LU needs them (a
+    /// pattern that is not symmetric, or an LU fallback: A is otherwise kept by rows, below); the
+    /// values of the matrix factorised (A's symmetric part, or the given P).
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     values: Vec<f64>,
@@ -278,10 +280,12 @@ impl LdltGmres {
         let t = Instant::now();
         self.col_ptr = a.symbolic().col_ptr().to_vec();
         self.row_idx = a.symbolic().row_idx().to_vec();
-        self.values = vec![0.0; self.row_idx.len()];
-        self.symmetric_values = vec![0.0; self.row_idx.len()];
-        self.row_values = vec![0.0; self.row_idx.len()];
         self.transpose = transpose_positions(&self.col_ptr, &self.row_idx);
+        let nnz = self.row_idx.len();
+        // a symmetric pattern keeps A by rows only (the LU fallback rebuilds the columns)
+        self.values = if self.transpose.is_some() { Vec::new() } else { vec![0.0; nnz] };
+        self.symmetric_values = if self.transpose.is_some() { vec![0.0; nnz] } else { Vec::new() };
+        self.row_values = if self.transpose.is_some() { vec![0.0; nnz] } else { Vec::new() };
         self.symbolic = None;
         self.ordering_used = None;
         self.factor_valid = false;
@@ -317,6 +321,10 @@ impl LdltGmres {
 
     fn factorize_lu(&mut self) -> Result<()> {
         let n = self.col_ptr.len() - 1;
+        if let Some(tr) = &self.transpose {
+            // A's columns from its rows: a_ij sits at the transposed position of a_ji
+            self.values = tr.iter().map(|&k| self.row_values[k]).collect();
+        }
         let lu = self.lu.get_or_insert_with(|| SparseLu::with_parallelism(self.par));
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         lu.factorize(SparseColMatRef::new(pattern, &self.values))?;
@@ -422,6 +430,61 @@ impl LdltGmres {
 /// Rows per task of the parallel product.
 const ROWS_PER_TASK: usize = 4096;
 
+/// From A's values `a` in its symmetric pattern (`transpose`: the position of a_ji for each
+/// a_ij): A by rows (`row_values`, see [`multiply_rows`]), the row sums of |A| (`row_sums`) and,
+/// if given, the symmetric part (`symmetric`); returns max |a_ij - a_ji| and max |a_ij|. Columns
+/// in parallel when `parallel`.
+fn split_values(col_ptr: &[usize], transpose: &[usize], a: &[f64], row_values: &mut [f64], symmetric: Option<&mut [f64]>, row_sums: &mut [f64], parallel: bool) -> (f64, f64) {
+    // the columns first..first + sums.len(), whose entries start at slot `base`
+    let columns = |first: usize, base: usize, rows: &mut [f64], mut sym: Option<&mut [f64]>, sums: &mut [f64]| {
+        let (mut worst, mut size) = (0.0f64, 0.0f64);
+        for (c, sum) in sums.iter_mut().enumerate() {
+            let mut total = 0.0;
+            for k in col_ptr[first + c]..col_ptr[first + c + 1] {
+                let (v, t) = (a[k], a[transpose[k]]);
+                rows[k - base] = t;
+                total += t.abs();
+                worst = worst.max((v - t).abs());
+                size = size.max(v.abs());
+                if let Some(s) = sym.as_deref_mut() {
+                    s[k - base] = 0.5 * (v + t);
+                }
+            }
+            *sum = total;
+        }
+        (worst, size)
+    };
+    let n = row_sums.len();
+    if !parallel {
+        return columns(0, 0, row_values, symmetric, row_sums);
+    }
+    // disjoint pieces of the output, ROWS_PER_TASK columns each
+    let mut tasks = Vec::with_capacity(n.div_ceil(ROWS_PER_TASK));
+    let (mut rows, mut sym, mut sums) = (row_values, symmetric, row_sums);
+    let mut first = 0;
+    while first < n {
+        let last = (first + ROWS_PER_TASK).min(n);
+        let len = col_ptr[last] - col_ptr[first];
+        let (r_here, r_rest) = std::mem::take(&mut rows).split_at_mut(len);
+        let (s_here, s_rest) = match sym.take() {
+            Some(s) => {
+                let (h, r) = s.split_at_mut(len);
+                (Some(h), Some(r))
+            }
+            None => (None, None),
+        };
+        let (m_here, m_rest) = std::mem::take(&mut sums).split_at_mut(last - first);
+        tasks.push((first, r_here, s_here, m_here));
+        (rows, sym, sums) = (r_rest, s_rest, m_rest);
+        first = last;
+    }
+    use rayon::prelude::*;
+    tasks
+        .into_par_iter()
+        .map(|(first, rows, sym, sums)| columns(first, col_ptr[first], rows, sym, sums))
+        .reduce(|| (0.0, 0.0), |x, y| (x.0.max(y.0), x.1.max(y.1)))
+}
+
 /// y = A x computed by rows, for a matrix of symmetric pattern: `row_values[k]` is
 /// a_{c, row_idx[k]} for the k-th stored entry of column c (A^T stored in A's pattern), so that
 /// y_c = sum_k row_values[k] x[row_idx[k]] over column c. Rows in parallel when `parallel`.
@@ -492,31 +555,39 @@ impl LinearSolver for LdltGmres {
         if !self.same_pattern(a) {
             self.analyse(a)?;
         }
-        self.values.copy_from_slice(a.val());
         self.r.resize(a.nrows(), 0.0);
-        self.r.iter_mut().for_each(|v| *v = 0.0);
-        for (k, v) in self.values.iter().enumerate() {
-            self.r[self.row_idx[k]] += v.abs();
-        }
-        self.norm_inf = self.r.iter().fold(0.0f64, |m, x| m.max(*x));
         let Some(tr) = &self.transpose else {
+            self.values.copy_from_slice(a.val());
+            self.r.iter_mut().for_each(|v| *v = 0.0);
+            for (k, v) in self.values.iter().enumerate() {
+                self.r[self.row_idx[k]] += v.abs();
+            }
+            self.norm_inf = self.r.iter().fold(0.0f64, |m, x| m.max(*x));
             self.factorize_lu()?;
             self.factored = true;
             return Ok(());
         };
-        let mut worst = 0.0f64;
-        for (((s, t), &v), &k) in self.symmetric_values.iter_mut().zip(self.row_values.iter_mut()).zip(&self.values).zip(tr) {
-            worst = worst.max((v - self.values[k]).abs());
-            *s = 0.5 * (v + self.values[k]);
-            *t = self.values[k];
-        }
-        let size = self.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        self.symmetric = worst <= SYMMETRY_TOL * size;
-        if let (Some(p), false, true) = (p, self.symmetric, self.use_preconditioner) {
-            if !crate::sparse::same_pattern(p.symbolic(), a.symbolic()) {
-                return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into()));
+        let given = match p {
+            Some(p) if self.use_preconditioner => {
+                if !crate::sparse::same_pattern(p.symbolic(), a.symbolic()) {
+                    return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into()));
+                }
+                Some(p)
             }
-            self.symmetric_values.copy_from_slice(p.val());
+            _ => None,
+        };
+        // one pass over A: A by rows, its row sums, its asymmetry and size, and its symmetric
+        // part unless a P will be factorised instead
+        let parallel = parallelism_for(a.nrows(), self.par) != Par::Seq;
+        let sym = if given.is_some() { None } else { Some(self.symmetric_values.as_mut_slice()) };
+        let (worst, size) = split_values(&self.col_ptr, tr, a.val(), &mut self.row_values, sym, &mut self.r, parallel);
+        self.norm_inf = self.r.iter().fold(0.0f64, |m, x| m.max(*x));
+        self.symmetric = worst <= SYMMETRY_TOL * size;
+        match given {
+            // a symmetric A is factorised itself
+            Some(_) if self.symmetric => self.symmetric_values.copy_from_slice(a.val()),
+            Some(p) => self.symmetric_values.copy_from_slice(p.val()),
+            None => {}
         }
         if self.reuse && self.factor_valid && !self.refactor_next {
             self.mode = Mode::Preconditioned;
