@@ -352,7 +352,14 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                     *d = alpha * x;
                 }
                 p.add_increment(&mut trial, &scaled);
-                let e = p.evaluate(&trial, t, false).ok().filter(|e| e.residual_norm.is_finite());
+                let e = p.evaluate(&trial, t, false);
+                if debug {
+                    match &e {
+                        Ok(e) => eprintln!("  line search alpha={alpha} |R|={:.3e}", e.residual_norm),
+                        Err(err) => eprintln!("  line search alpha={alpha} refused: {err}"),
+                    }
+                }
+                let e = e.ok().filter(|e| e.residual_norm.is_finite());
                 if let Some(e) = e.filter(|e| e.residual_norm <= (1.0 - 1e-4 * alpha) * r0) {
                     // accepted: the next iterate is this trial, whose residual is known
                     known = Some(e);
