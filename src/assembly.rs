@@ -1,42 +1,52 @@
 //! The generic assembler: evaluates any [`Element`] set in parallel (rayon) and adds the local
 //! residuals and tangents into a full-length force vector and the value array of a
-//! [`SparsePattern`]. Elements are split into colours such that no two elements of one colour share a
-//! node; the elements of a colour then write disjoint entries and run in parallel without locks.
+//! [`SparsePattern`]. The elements are cut into blocks of consecutive elements, and the blocks into
+//! colours such that no two blocks of one colour share a node; the blocks of a colour then write
+//! disjoint entries and run in parallel without locks, each block's elements one after the other.
 //! Each thread keeps one workspace and one local system: nothing is allocated per element.
+//!
+//! Why blocks and not single elements: the scatter into the value arrays is memory-bound. Walking
+//! the mesh in its own element order, an element finds most of the columns of its nodes in cache
+//! (its neighbour wrote them just before); colouring single elements scatters every colour over the
+//! whole mesh, so each node's columns are fetched from memory once per element around it. Measured
+//! on `stamp bench`'s plate at n = 400 (160 000 elements, 0.8 GB of value arrays), one thread: a
+//! full assembly in element order 0.79-0.80 s against 1.09-1.15 s in element colours.
 
 use crate::dofs::DofMap;
 use crate::element::{Element, LocalSystem};
 use crate::error::{Result, StampError};
 use crate::sparse::SparsePattern;
 use rayon::prelude::*;
+use std::ops::Range;
 
-/// Greedy colouring of the elements so that elements of one colour share no node.
-pub fn color_elements(num_nodes: usize, num_elements: usize, element_nodes: impl Fn(usize) -> Vec<usize>) -> Vec<Vec<usize>> {
-    // node -> bitmask of colours already used by its elements (up to 64 colours, then fall back)
+/// Greedy colouring of sets of nodes (an element's, or a block of elements') so that sets of one
+/// colour share no node. `nodes_of(k, visit)` calls `visit` with every node of set k.
+pub fn color_node_sets(num_nodes: usize, num_sets: usize, nodes_of: impl Fn(usize, &mut dyn FnMut(usize))) -> Vec<Vec<usize>> {
+    // node -> bitmask of colours already used by the sets that hold it (up to 64 colours, then fall back)
     let mut used: Vec<u64> = vec![0; num_nodes];
     let mut colors: Vec<Vec<usize>> = Vec::new();
-    for e in 0..num_elements {
-        let nodes = element_nodes(e);
-        let mask = nodes.iter().fold(0u64, |m, &n| m | used[n]);
-        let c = (!mask).trailing_zeros() as usize;
-        let c = c.min(63);
+    for k in 0..num_sets {
+        let mut mask = 0u64;
+        nodes_of(k, &mut |n| mask |= used[n]);
+        let c = ((!mask).trailing_zeros() as usize).min(63);
         if c >= colors.len() {
             colors.resize(c + 1, Vec::new());
         }
-        colors[c].push(e);
-        for &n in &nodes {
-            used[n] |= 1u64 << c;
-        }
+        colors[c].push(k);
+        nodes_of(k, &mut |n| used[n] |= 1u64 << c);
     }
-    // colour 63 may hold conflicting elements if more than 63 colours were needed: split it serially
+    // colour 63 may hold conflicting sets if more than 63 colours were needed: one colour each
     if colors.len() == 64 {
-        let overflow = std::mem::take(&mut colors[63]);
-        colors.pop();
-        for e in overflow {
-            colors.push(vec![e]);
-        }
+        let overflow = colors.pop().unwrap_or_default();
+        colors.extend(overflow.into_iter().map(|k| vec![k]));
     }
     colors
+}
+
+/// Elements of one block of the parallel assembly: enough consecutive elements that a block's
+/// scatter stays in cache, few enough that every colour has many blocks for the threads.
+fn block_len(num_elements: usize) -> usize {
+    (num_elements / 64).clamp(32, 512)
 }
 
 /// Pointer wrapper used to write disjoint entries from several threads.
@@ -45,22 +55,32 @@ struct SharedMut(*mut f64);
 unsafe impl Send for SharedMut {}
 unsafe impl Sync for SharedMut {}
 
-/// Assembles one element set into a pattern. Built once per model; reused for every assembly.
 /// Element count below which the assembly runs on the calling thread.
 pub const PARALLEL_MIN_ELEMENTS: usize = 2048;
 
+/// Assembles one element set into a pattern. Built once per model; reused for every assembly.
 pub struct Assembler {
+    /// Blocks of consecutive elements.
+    blocks: Vec<Range<usize>>,
+    /// Blocks of each colour (no two share a node).
     colors: Vec<Vec<usize>>,
 }
 
 impl Assembler {
-    /// Colour the elements of `element`.
+    /// Cut the elements of `element` into blocks and colour the blocks.
     pub fn new<E: Element>(element: &E, num_nodes: usize) -> Self {
-        let colors = color_elements(num_nodes, element.num_elements(), |e| element.element_nodes(e).to_vec());
-        Assembler { colors }
+        let ne = element.num_elements();
+        let len = block_len(ne);
+        let blocks: Vec<Range<usize>> = (0..ne.div_ceil(len)).map(|b| b * len..((b + 1) * len).min(ne)).collect();
+        let colors = color_node_sets(num_nodes, blocks.len(), |b, visit| {
+            for e in blocks[b].clone() {
+                element.element_nodes(e).iter().for_each(|&n| visit(n));
+            }
+        });
+        Assembler { blocks, colors }
     }
 
-    /// Number of colours (for diagnostics).
+    /// Number of colours of the blocks (for diagnostics).
     pub fn num_colors(&self) -> usize {
         self.colors.len()
     }
@@ -164,21 +184,19 @@ impl Assembler {
                 (local.energy, usize::MAX)
             };
         let mut refused = usize::MAX;
+        // the elements of a range one after the other: (energy, lowest refusing element)
+        let run = |st: &mut _, elements: Range<usize>| elements.fold((0.0, usize::MAX), |(w, bad), e| {
+            let (we, be) = kernel(st, e);
+            (w + we, bad.min(be))
+        });
         if !parallel {
-            let mut state = init();
-            for color in &self.colors {
-                for &e in color {
-                    let (w, bad) = kernel(&mut state, e);
-                    energy += w;
-                    refused = refused.min(bad);
-                }
-            }
+            // one thread: the whole mesh in element order
+            (energy, refused) = run(&mut init(), 0..element.num_elements());
         } else {
             for color in &self.colors {
                 let (w, bad) = color
                     .par_iter()
-                    .with_min_len(256)
-                    .map_init(init, |st, &e| kernel(st, e))
+                    .map_init(init, |st, &b| run(st, self.blocks[b].clone()))
                     .reduce(|| (0.0, usize::MAX), |a, b| (a.0 + b.0, a.1.min(b.1)));
                 energy += w;
                 refused = refused.min(bad);
@@ -193,5 +211,51 @@ impl Assembler {
         element.evaluate(refused, &ue, &mut element.new_workspace(), &mut local, false);
         let reason = local.inadmissible.unwrap_or_else(|| "refused (no reason given)".into());
         Err(StampError::Inadmissible { element: refused, reason })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sets of one colour share no node, and every set has exactly one colour: on strips of a
+    /// 30 x 30 grid of quads, in order and shuffled (blocks scattered over the mesh need more
+    /// colours, and more than 63 fall back to one set a colour).
+    #[test]
+    fn sets_of_one_colour_share_no_node() {
+        let (nx, ny) = (30, 30);
+        let cell = |e: usize| {
+            let (i, j) = (e % nx, e / nx);
+            let n = j * (nx + 1) + i;
+            [n, n + 1, n + nx + 2, n + nx + 1]
+        };
+        let mut order: Vec<usize> = (0..nx * ny).collect();
+        for shuffled in [false, true] {
+            if shuffled {
+                // a fixed permutation that scatters consecutive cells over the grid
+                order.sort_by_key(|&e| (e * 7919) % (nx * ny));
+            }
+            for len in [1, 7, 40] {
+                let sets: Vec<Vec<usize>> = order.chunks(len).map(|c| c.to_vec()).collect();
+                let colors = color_node_sets((nx + 1) * (ny + 1), sets.len(), |k, visit| sets[k].iter().for_each(|&e| cell(e).iter().for_each(|&n| visit(n))));
+                let mut seen = vec![0usize; sets.len()];
+                for color in &colors {
+                    let mut owner = vec![usize::MAX; (nx + 1) * (ny + 1)];
+                    for &k in color {
+                        seen[k] += 1;
+                        for &e in &sets[k] {
+                            for n in cell(e) {
+                                assert!(owner[n] == usize::MAX || owner[n] == k, "shuffled {shuffled}, len {len}: sets {} and {k} share node {n}", owner[n]);
+                                owner[n] = k;
+                            }
+                        }
+                    }
+                }
+                assert!(seen.iter().all(|&s| s == 1), "shuffled {shuffled}, len {len}: every set once");
+                if !shuffled && len == 1 {
+                    assert_eq!(colors.len(), 4, "single quads of a grid: four colours");
+                }
+            }
+        }
     }
 }
