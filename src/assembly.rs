@@ -58,9 +58,61 @@ unsafe impl Sync for SharedMut {}
 /// Element count below which the assembly runs on the calling thread.
 pub const PARALLEL_MIN_ELEMENTS: usize = 2048;
 
+/// Most colours of the blocks in the mesh's element order; more mean that consecutive elements
+/// lie far apart (a mesh generator's order), and the elements are put in breadth-first order.
+const MAX_BLOCK_COLORS: usize = 8;
+
+/// The elements in breadth-first order through shared nodes (each connected piece from its
+/// lowest-numbered element): consecutive elements are neighbours, so blocks of them are compact
+/// strips along the front, whatever order the mesh came in.
+pub fn breadth_first_order(num_nodes: usize, num_elements: usize, element_nodes: impl Fn(usize) -> Vec<usize>) -> Vec<usize> {
+    // node -> elements, compressed
+    let mut start = vec![0usize; num_nodes + 1];
+    for e in 0..num_elements {
+        element_nodes(e).iter().for_each(|&n| start[n + 1] += 1);
+    }
+    for n in 0..num_nodes {
+        start[n + 1] += start[n];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0usize; start[num_nodes]];
+    for e in 0..num_elements {
+        for n in element_nodes(e) {
+            around[fill[n]] = e;
+            fill[n] += 1;
+        }
+    }
+    let mut order = Vec::with_capacity(num_elements);
+    let mut seen = vec![false; num_elements];
+    for root in 0..num_elements {
+        if seen[root] {
+            continue;
+        }
+        seen[root] = true;
+        let mut head = order.len();
+        order.push(root);
+        while head < order.len() {
+            let e = order[head];
+            head += 1;
+            for n in element_nodes(e) {
+                for &f in &around[start[n]..start[n + 1]] {
+                    if !seen[f] {
+                        seen[f] = true;
+                        order.push(f);
+                    }
+                }
+            }
+        }
+    }
+    order
+}
+
 /// Assembles one element set into a pattern. Built once per model; reused for every assembly.
 pub struct Assembler {
-    /// Blocks of consecutive elements.
+    /// The elements in assembly order: the mesh's own, or breadth-first where the mesh's would
+    /// scatter the blocks (see [`MAX_BLOCK_COLORS`]).
+    order: Vec<usize>,
+    /// Blocks: ranges of consecutive elements of `order`.
     blocks: Vec<Range<usize>>,
     /// Blocks of each colour (no two share a node).
     colors: Vec<Vec<usize>>,
@@ -72,12 +124,20 @@ impl Assembler {
         let ne = element.num_elements();
         let len = block_len(ne);
         let blocks: Vec<Range<usize>> = (0..ne.div_ceil(len)).map(|b| b * len..((b + 1) * len).min(ne)).collect();
-        let colors = color_node_sets(num_nodes, blocks.len(), |b, visit| {
-            for e in blocks[b].clone() {
-                element.element_nodes(e).iter().for_each(|&n| visit(n));
-            }
-        });
-        Assembler { blocks, colors }
+        let color = |order: &[usize]| {
+            color_node_sets(num_nodes, blocks.len(), |b, visit| {
+                for &e in &order[blocks[b].clone()] {
+                    element.element_nodes(e).iter().for_each(|&n| visit(n));
+                }
+            })
+        };
+        let mut order: Vec<usize> = (0..ne).collect();
+        let mut colors = color(&order);
+        if colors.len() > MAX_BLOCK_COLORS {
+            order = breadth_first_order(num_nodes, ne, |e| element.element_nodes(e).to_vec());
+            colors = color(&order);
+        }
+        Assembler { order, blocks, colors }
     }
 
     /// Number of colours of the blocks (for diagnostics).
@@ -185,12 +245,12 @@ impl Assembler {
             };
         let mut refused = usize::MAX;
         // the elements of a range one after the other: (energy, lowest refusing element)
-        let run = |st: &mut _, elements: Range<usize>| elements.fold((0.0, usize::MAX), |(w, bad), e| {
+        let run = |st: &mut _, elements: Range<usize>| self.order[elements].iter().fold((0.0, usize::MAX), |(w, bad), &e| {
             let (we, be) = kernel(st, e);
             (w + we, bad.min(be))
         });
         if !parallel {
-            // one thread: the whole mesh in element order
+            // one thread: the whole mesh in assembly order
             (energy, refused) = run(&mut init(), 0..element.num_elements());
         } else {
             for color in &self.colors {
@@ -257,5 +317,13 @@ mod tests {
                 }
             }
         }
+        // the shuffled grid in breadth-first order: every cell once, and blocks of 40 need few colours
+        let bfs = breadth_first_order((nx + 1) * (ny + 1), nx * ny, |k| cell(order[k]).to_vec());
+        let mut sorted = bfs.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..nx * ny).collect::<Vec<_>>());
+        let sets: Vec<Vec<usize>> = bfs.chunks(40).map(|c| c.iter().map(|&k| order[k]).collect()).collect();
+        let colors = color_node_sets((nx + 1) * (ny + 1), sets.len(), |k, visit| sets[k].iter().for_each(|&e| cell(e).iter().for_each(|&n| visit(n))));
+        assert!(colors.len() <= MAX_BLOCK_COLORS, "breadth-first blocks of the shuffled grid: {} colours", colors.len());
     }
 }
