@@ -57,7 +57,6 @@ const E33: usize = 24; // + g
 const LINE: usize = 28; // + pt*2 + face: full covariant shear on the lines (parallelograms)
 const TYING: usize = 36; // + pt*2 + face: full covariant shear at the edge midpoints (other quads)
 const NSAMPLE: usize = 44;
-const NQUAD: usize = 44; // samples with a Hessian (nonlinear kinematics)
 /// Per membrane strain kind (E11, E22, E12) and Gauss point, the first Gauss point of its
 /// projection group (same xi2, same xi1, all; see [`crate::geometry`]'s `proj`).
 const MEMBRANE_GROUP_FIRST: [[usize; 4]; 3] = [[0, 0, 2, 2], [0, 1, 1, 0], [0, 0, 0, 0]];
@@ -104,6 +103,9 @@ pub struct PlateWorkspace {
     /// tangent's one-way coupling (b_ab33 = 0, b_33ab != 0).
     coupling: [[f64; NDOF]; 4],
     mu: [f64; NSAMPLE],
+    /// The (sample, coefficient) terms of every assumed strain at every Gauss point (of a shared
+    /// membrane strain: at the first point of its group only).
+    terms: [[Terms; NSTRAIN]; 4],
     /// The smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] of the faces at the Gauss
     /// points found by the last `compute_samples` (see [`PlateElements::smallest_volume_ratio`]).
     volume_ratio: f64,
@@ -121,6 +123,8 @@ pub struct PlateElements {
     cells: Vec<[usize; 4]>,
     geometry: Vec<ElementGeometry>,
     d: [[f64; NSTRAIN]; NSTRAIN],
+    /// The nonzero entries (column, value) of every row of D.
+    d_rows: [([(usize, f64); NSTRAIN], usize); NSTRAIN],
     section: Section,
     kinematics: Kinematics,
     /// D has the one-way coupling of T33 to the in-plane strains (nu != 0): the tangent is not
@@ -128,8 +132,9 @@ pub struct PlateElements {
     coupled: bool,
 }
 
-/// Up to 8 (sample, coefficient) terms of an assumed strain.
-type Terms = ([(usize, f64); 8], usize);
+/// Up to 4 (sample, coefficient) terms of an assumed strain (4 projection weights of a membrane
+/// strain, 2 covariant components times 1 line or 2 tying samples of a shear strain).
+type Terms = ([(usize, f64); 4], usize);
 
 impl PlateElements {
     /// Plate elements on every cell of `mesh`, with a validated section.
@@ -139,7 +144,14 @@ impl PlateElements {
         let geometry = (0..mesh.num_cells()).map(|c| ElementGeometry::new(&mesh.cell_coords(c), c)).collect::<Result<Vec<_>>>()?;
         let d = section.stiffness();
         let coupled = (0..NSTRAIN).any(|c| c != E33_ROW && d[E33_ROW][c] != 0.0);
-        Ok(PlateElements { cells: mesh.cells.clone(), geometry, d, section, kinematics, coupled })
+        let mut d_rows = [([(0, 0.0); NSTRAIN], 0); NSTRAIN];
+        for (r, (entries, n)) in d_rows.iter_mut().enumerate() {
+            for c in (0..NSTRAIN).filter(|&c| d[r][c] != 0.0) {
+                entries[*n] = (c, d[r][c]);
+                *n += 1;
+            }
+        }
+        Ok(PlateElements { cells: mesh.cells.clone(), geometry, d, d_rows, section, kinematics, coupled })
     }
 
     pub fn section(&self) -> &Section {
@@ -157,14 +169,15 @@ impl PlateElements {
         &self.geometry[e]
     }
 
-    /// The (sample, coefficient) terms of assumed strain component `c` at Gauss point `g`.
-    fn terms(geo: &ElementGeometry, g: usize, c: usize) -> Terms {
-        let mut t = [(0usize, 0.0); 8];
-        let mut n = 0;
+    /// The (sample, coefficient) terms of assumed strain component `c` at Gauss point `g`, written
+    /// in place (a returned copy was read back before its stores had retired: store-forwarding stalls).
+    fn terms(geo: &ElementGeometry, g: usize, c: usize, out: &mut Terms) {
+        let (t, n) = out;
+        *n = 0;
         let mut push = |s: usize, w: f64| {
             if w != 0.0 {
-                t[n] = (s, w);
-                n += 1;
+                t[*n] = (s, w);
+                *n += 1;
             }
         };
         let face = c % 2;
@@ -192,7 +205,6 @@ impl PlateElements {
             }
             _ => push(E33 + g, 1.0),
         }
-        (t, n)
     }
 
     /// Evaluate every displacement-based strain sample of element e at local dofs `v`.
@@ -272,7 +284,9 @@ impl PlateElements {
         let mut out = GaussState::default();
         for g in 0..4 {
             for c in 0..NSTRAIN {
-                let (t, n) = Self::terms(geo, g, c);
+                let mut terms = ([(0, 0.0); 4], 0);
+                Self::terms(geo, g, c, &mut terms);
+                let (t, n) = terms;
                 out.strain[g][c] = t[..n].iter().map(|&(s, w)| w * ws.samples[s].val).sum();
             }
             for r in 0..NSTRAIN {
@@ -313,6 +327,7 @@ impl Element for PlateElements {
             db: [[0.0; NDOF]; 4 * NSTRAIN],
             coupling: [[0.0; NDOF]; 4],
             mu: [0.0; NSAMPLE],
+            terms: [[([(0, 0.0); 4], 0); NSTRAIN]; 4],
             volume_ratio: 1.0,
         }
     }
@@ -332,9 +347,10 @@ impl Element for PlateElements {
         let d = &self.d;
         // P asked for and different from the tangent
         let split = with_tangent && self.coupled && !out.preconditioner.is_empty();
-        ws.mu = [0.0; NSAMPLE];
+        let PlateWorkspace { samples, b, db, coupling, mu, terms, .. } = ws;
+        let samples: &[Sample; NSAMPLE] = samples;
+        *mu = [0.0; NSAMPLE];
         let mut strains = [[0.0; NSTRAIN]; 4];
-        let mut all_terms = [[([(0usize, 0.0); 8], 0usize); NSTRAIN]; 4];
         for g in 0..4 {
             let w = geo.wdet[g];
             for c in 0..NSTRAIN {
@@ -342,105 +358,113 @@ impl Element for PlateElements {
                 // same at every point of its group: computed at the group's first point, copied
                 let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
                 if first < g {
-                    all_terms[g][c] = all_terms[first][c];
                     strains[g][c] = strains[first][c];
-                    ws.b[g * NSTRAIN + c] = ws.b[first * NSTRAIN + c];
                     continue;
                 }
-                all_terms[g][c] = Self::terms(geo, g, c);
-                let (t, n) = &all_terms[g][c];
-                let row = &mut ws.b[g * NSTRAIN + c];
-                *row = [0.0; NDOF];
-                let mut strain = 0.0;
-                for &(s, coef) in &t[..*n] {
-                    let smp = &ws.samples[s];
-                    strain += coef * smp.val;
-                    for (r, &gr) in row.iter_mut().zip(&smp.grad) {
-                        *r += coef * gr;
-                    }
-                }
-                strains[g][c] = strain;
+                Self::terms(geo, g, c, &mut terms[g][c]);
+                let (t, n) = &terms[g][c];
+                strains[g][c] = t[..*n].iter().fold(0.0, |sum, &(s, coef)| sum + coef * samples[s].val);
             }
             let strain = strains[g];
-            let terms = &all_terms[g];
-            let rows = &ws.b[g * NSTRAIN..(g + 1) * NSTRAIN];
             let mut stress = [0.0; NSTRAIN];
             for r in 0..NSTRAIN {
                 stress[r] = (0..NSTRAIN).map(|c| d[r][c] * strain[c]).sum();
             }
             out.energy += 0.5 * w * (0..NSTRAIN).map(|c| strain[c] * stress[c]).sum::<f64>();
+            // weights mu_s = sum over the assumed strains c that use sample s of w T_c coef_cs:
+            // of the sample gradients in the internal force, of the sample Hessians in the
+            // geometric stiffness
             for c in 0..NSTRAIN {
-                let f = w * stress[c];
-                for (r, &b) in out.residual.iter_mut().zip(&rows[c]) {
-                    *r += f * b;
-                }
-            }
-            if !with_tangent {
-                continue;
-            }
-            // w D B at this Gauss point; for P the row of T33 split into its own strain's part
-            // (kept in db: w D0 B, D0 symmetric) and the one-way coupling to the in-plane strains
-            for r in 0..NSTRAIN {
-                let mut row = [0.0; NDOF];
-                let mut coupling = [0.0; NDOF];
-                for c in 0..NSTRAIN {
-                    let drc = w * d[r][c];
-                    if drc != 0.0 {
-                        let target = if split && r == E33_ROW && c != E33_ROW { &mut coupling } else { &mut row };
-                        for (x, &b) in target.iter_mut().zip(&rows[c]) {
-                            *x += drc * b;
-                        }
-                    }
-                }
-                ws.db[g * NSTRAIN + r] = row;
-                if split && r == E33_ROW {
-                    ws.coupling[g] = coupling;
-                }
-            }
-            // weights of the sample Hessians in the geometric stiffness
-            for c in 0..NSTRAIN {
-                let (t, n) = &terms[c];
+                let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
+                let (t, n) = &terms[first][c];
                 for &(s, coef) in &t[..*n] {
-                    ws.mu[s] += w * stress[c] * coef;
+                    mu[s] += w * stress[c] * coef;
                 }
             }
+        }
+        // internal force sum_g w B_g^T T_g = sum_s mu_s dE_s/dV over the samples this element uses
+        let residual: &mut [f64; NDOF] = (&mut out.residual[..NDOF]).try_into().unwrap();
+        let shear = if geo.parallelogram { LINE } else { TYING };
+        for s in (MEM..E33 + 4).chain(shear..shear + 8) {
+            axpy(residual, mu[s], &samples[s].grad);
         }
         if !with_tangent {
             return;
         }
+        for g in 0..4 {
+            let w = geo.wdet[g];
+            // the rows dE_c/dV of B at this Gauss point (shared membrane rows copied)
+            for c in 0..NSTRAIN {
+                let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
+                if first < g {
+                    b[g * NSTRAIN + c] = b[first * NSTRAIN + c];
+                    continue;
+                }
+                let (t, n) = &terms[g][c];
+                let row = &mut b[g * NSTRAIN + c];
+                let (s0, c0) = t[0];
+                *row = samples[s0].grad.map(|x| c0 * x);
+                for &(s, coef) in &t[1..*n] {
+                    axpy(row, coef, &samples[s].grad);
+                }
+            }
+            // w D B at this Gauss point; for P the row of T33 split into its own strain's part
+            // (kept in db: w D0 B, D0 symmetric) and the one-way coupling to the in-plane strains
+            let rows = &b[g * NSTRAIN..(g + 1) * NSTRAIN];
+            for r in 0..NSTRAIN {
+                let row = &mut db[g * NSTRAIN + r];
+                *row = [0.0; NDOF];
+                if split && r == E33_ROW {
+                    coupling[g] = [0.0; NDOF];
+                }
+                for &(c, drc) in &self.d_rows[r].0[..self.d_rows[r].1] {
+                    let target = if split && r == E33_ROW && c != E33_ROW { &mut coupling[g] } else { &mut *row };
+                    axpy(target, w * drc, &rows[c]);
+                }
+            }
+        }
         // material stiffness: sum over the Gauss points of B^T (w D0 B), one 24 x 44 x 24 product,
         // and of the coupling b33^T (w c^T B_in): P gets the first, the tangent both
-        let b = MatRef::from_row_major_slice(ws.b.as_flattened(), 4 * NSTRAIN, NDOF);
-        let db = MatRef::from_row_major_slice(ws.db.as_flattened(), 4 * NSTRAIN, NDOF);
+        let bm = MatRef::from_row_major_slice(b.as_flattened(), 4 * NSTRAIN, NDOF);
+        let dbm = MatRef::from_row_major_slice(db.as_flattened(), 4 * NSTRAIN, NDOF);
         let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..NDOF * NDOF], NDOF, NDOF);
-        matmul(k, Accum::Add, b.transpose(), db, 1.0, Par::Seq);
+        matmul(k, Accum::Add, bm.transpose(), dbm, 1.0, Par::Seq);
         clean_upper_vector_state();
         if split {
             out.preconditioner[..NDOF * NDOF].copy_from_slice(&out.tangent[..NDOF * NDOF]);
             // the rows dE33/dV of the four Gauss points: every NSTRAIN-th row of B
-            let b33 = MatRef::from_row_major_slice_with_stride(&ws.b.as_flattened()[E33_ROW * NDOF..], 4, NDOF, NSTRAIN * NDOF);
-            let coupling = MatRef::from_row_major_slice(ws.coupling.as_flattened(), 4, NDOF);
+            let b33 = MatRef::from_row_major_slice_with_stride(&b.as_flattened()[E33_ROW * NDOF..], 4, NDOF, NSTRAIN * NDOF);
+            let cm = MatRef::from_row_major_slice(coupling.as_flattened(), 4, NDOF);
             let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..NDOF * NDOF], NDOF, NDOF);
-            matmul(k, Accum::Add, b33.transpose(), coupling, 1.0, Par::Seq);
+            matmul(k, Accum::Add, b33.transpose(), cm, 1.0, Par::Seq);
             clean_upper_vector_state();
         }
         // geometric stiffness: sum_s mu_s Hess_s (x) I3, Hess_s = scale (a b^T + b a^T)
         if self.kinematics == Kinematics::Nonlinear {
-            // X = sum_s mu_s scale_s a_s b_s^T, and H = X + X^T
+            // X = sum_s mu_s scale_s a_s b_s^T, and H = X + X^T; a_s and b_s of a membrane sample
+            // have nonzeros only at the pairs of its face, a_s of a shear sample likewise
             let mut x = [[0.0; NPAIR]; NPAIR];
-            for (smp, &m) in ws.samples[..NQUAD].iter().zip(&ws.mu[..NQUAD]) {
-                let f = m * smp.scale;
-                if f == 0.0 {
-                    continue;
-                }
-                for kk in 0..NPAIR {
+            let face_pairs = |face: usize| [face, face + 2, face + 4, face + 6];
+            let mut add = |s: usize, rows: &[usize], cols: &[usize]| {
+                let smp = &samples[s];
+                let f = mu[s] * smp.scale;
+                for &kk in rows {
                     let fa = f * smp.a[kk];
-                    if fa != 0.0 {
-                        for (xl, &bl) in x[kk].iter_mut().zip(&smp.b) {
-                            *xl += fa * bl;
-                        }
+                    for &l in cols {
+                        x[kk][l] += fa * smp.b[l];
                     }
                 }
+            };
+            let all: [usize; NPAIR] = std::array::from_fn(|k| k);
+            for s in MEM..E33 {
+                let pairs = face_pairs((s - MEM) % 6 / 3);
+                add(s, &pairs, &pairs);
+            }
+            for s in E33..E33 + 4 {
+                add(s, &all, &all);
+            }
+            for s in shear..shear + 8 {
+                add(s, &face_pairs(s % 2), &all);
             }
             for kk in 0..NPAIR {
                 for l in 0..NPAIR {
@@ -456,6 +480,14 @@ impl Element for PlateElements {
                 }
             }
         }
+    }
+}
+
+/// y += a x over the element dofs (fixed size and distinct borrows: vectorised, no bounds checks).
+#[inline(always)]
+fn axpy(y: &mut [f64; NDOF], a: f64, x: &[f64; NDOF]) {
+    for (yi, &xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
     }
 }
 
