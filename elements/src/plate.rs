@@ -92,6 +92,37 @@ unsafe fn zero_upper() {
     std::arch::x86_64::_mm256_zeroupper()
 }
 
+/// The deformed transverse fibre g3 = e3 + (v+ - v-)/h at the point with shape functions `n`.
+#[inline(always)]
+fn fibre(n: &[f64; 4], h: f64, v: &[f64]) -> Affine {
+    let mut c = [0.0; NPAIR];
+    for a in 0..4 {
+        c[2 * a] = -n[a] / h;
+        c[2 * a + 1] = n[a] / h;
+    }
+    Affine::new([0.0, 0.0, 1.0], c, v)
+}
+
+/// The deformed tangent g0 + v_face,a of a face, `dn` the shape-function derivatives along it.
+#[inline(always)]
+fn face_tangent(g0: [f64; 2], dn: [f64; 4], face: usize, v: &[f64]) -> Affine {
+    let mut c = [0.0; NPAIR];
+    for a in 0..4 {
+        c[2 * a + face] = dn[a];
+    }
+    Affine::new([g0[0], g0[1], 0.0], c, v)
+}
+
+/// The strain s gA . gB - its reference value, full or linear part.
+#[inline(always)]
+fn put(sample: &mut Sample, full: bool, scale: f64, a: &Affine, b: &Affine) {
+    if full {
+        sample.quadratic(scale, a, b)
+    } else {
+        sample.linear(scale, a, b)
+    }
+}
+
 /// Per-thread scratch memory of the plate element.
 pub struct PlateWorkspace {
     samples: Box<[Sample; NSAMPLE]>,
@@ -171,6 +202,7 @@ impl PlateElements {
 
     /// The (sample, coefficient) terms of assumed strain component `c` at Gauss point `g`, written
     /// in place (a returned copy was read back before its stores had retired: store-forwarding stalls).
+    #[inline(always)]
     fn terms(geo: &ElementGeometry, g: usize, c: usize, out: &mut Terms) {
         let (t, n) = out;
         *n = 0;
@@ -208,33 +240,15 @@ impl PlateElements {
     }
 
     /// Evaluate every displacement-based strain sample of element e at local dofs `v`.
+    #[inline(always)]
     fn compute_samples(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace) {
         let geo = &self.geometry[e];
         let h = self.section.thickness();
         let nonlinear = self.kinematics == Kinematics::Nonlinear;
-        let fibre = |n: &[f64; 4]| {
-            let mut c = [0.0; NPAIR];
-            for a in 0..4 {
-                c[2 * a] = -n[a] / h;
-                c[2 * a + 1] = n[a] / h;
-            }
-            Affine::new([0.0, 0.0, 1.0], c, v)
-        };
-        let tangent = |g0: [f64; 2], dn: [f64; 4], face: usize| {
-            let mut c = [0.0; NPAIR];
-            for a in 0..4 {
-                c[2 * a + face] = dn[a];
-            }
-            Affine::new([g0[0], g0[1], 0.0], c, v)
-        };
+        let fibre = |n: &[f64; 4]| fibre(n, h, v);
+        let tangent = |g0: [f64; 2], dn: [f64; 4], face: usize| face_tangent(g0, dn, face, v);
         let s = &mut ws.samples;
-        let mut put = |id: usize, scale: f64, a: &Affine, b: &Affine, full: bool| {
-            if full && nonlinear {
-                s[id].quadratic(scale, a, b)
-            } else {
-                s[id].linear(scale, a, b)
-            }
-        };
+        let mut put = |id: usize, scale: f64, a: &Affine, b: &Affine, full: bool| put(&mut s[id], full && nonlinear, scale, a, b);
         // the reference frame's orientation: det[G1, G2, G3] with G3 = e3
         let reference = geo.frame[0][0] * geo.frame[1][1] - geo.frame[0][1] * geo.frame[1][0];
         let mut volume_ratio = f64::INFINITY;
@@ -336,6 +350,13 @@ impl Element for PlateElements {
     /// [`PlateElements::smallest_volume_ratio`]; it still computes the residual and tangent there,
     /// which the tangent tests use); the linear theory has no such limit.
     fn evaluate(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_kernel(e, v, ws, out, with_tangent)
+    }
+}
+
+impl PlateElements {
+    #[inline(always)]
+    fn evaluate_kernel(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
         self.compute_samples(e, v, ws);
         if self.kinematics == Kinematics::Nonlinear && ws.volume_ratio <= 0.0 {
             out.inadmissible = Some(format!(
@@ -383,10 +404,14 @@ impl Element for PlateElements {
             }
         }
         // internal force sum_g w B_g^T T_g = sum_s mu_s dE_s/dV over the samples this element uses
-        let residual: &mut [f64; NDOF] = (&mut out.residual[..NDOF]).try_into().unwrap();
+        // (sums in local arrays, kept in registers: no store-to-load chain through memory)
         let shear = if geo.parallelogram { LINE } else { TYING };
+        let mut residual = [0.0; NDOF];
         for s in (MEM..E33 + 4).chain(shear..shear + 8) {
-            axpy(residual, mu[s], &samples[s].grad);
+            axpy(&mut residual, mu[s], &samples[s].grad);
+        }
+        for (r, x) in out.residual.iter_mut().zip(residual) {
+            *r += x;
         }
         if !with_tangent {
             return;
@@ -401,25 +426,27 @@ impl Element for PlateElements {
                     continue;
                 }
                 let (t, n) = &terms[g][c];
-                let row = &mut b[g * NSTRAIN + c];
-                let (s0, c0) = t[0];
-                *row = samples[s0].grad.map(|x| c0 * x);
-                for &(s, coef) in &t[1..*n] {
-                    axpy(row, coef, &samples[s].grad);
+                let mut row = [0.0; NDOF];
+                for &(s, coef) in &t[..*n] {
+                    axpy(&mut row, coef, &samples[s].grad);
                 }
+                b[g * NSTRAIN + c] = row;
             }
             // w D B at this Gauss point; for P the row of T33 split into its own strain's part
             // (kept in db: w D0 B, D0 symmetric) and the one-way coupling to the in-plane strains
             let rows = &b[g * NSTRAIN..(g + 1) * NSTRAIN];
             for r in 0..NSTRAIN {
-                let row = &mut db[g * NSTRAIN + r];
-                *row = [0.0; NDOF];
-                if split && r == E33_ROW {
-                    coupling[g] = [0.0; NDOF];
-                }
+                let (mut row, mut cpl) = ([0.0; NDOF], [0.0; NDOF]);
                 for &(c, drc) in &self.d_rows[r].0[..self.d_rows[r].1] {
-                    let target = if split && r == E33_ROW && c != E33_ROW { &mut coupling[g] } else { &mut *row };
-                    axpy(target, w * drc, &rows[c]);
+                    if split && r == E33_ROW && c != E33_ROW {
+                        axpy(&mut cpl, w * drc, &rows[c]);
+                    } else {
+                        axpy(&mut row, w * drc, &rows[c]);
+                    }
+                }
+                db[g * NSTRAIN + r] = row;
+                if split && r == E33_ROW {
+                    coupling[g] = cpl;
                 }
             }
         }
@@ -574,7 +601,7 @@ mod tests {
     }
 
     /// The kernel (sample-weighted internal force, shared membrane rows, sparse D, geometric
-    /// stiffness over the face pairs) against the plain computation, on a distorted element (tying
+    /// stiffness over the face pairs; AVX2 and baseline builds) against the plain computation, on a distorted element (tying
     /// shear) and a parallelogram (line shear), both kinematics, at a large-displacement state.
     #[test]
     fn kernel_agrees_with_the_plain_computation() {
@@ -600,12 +627,18 @@ mod tests {
                 plate.evaluate(0, &v, &mut ws, &mut alone, true);
                 let mut residual = LocalSystem::new(NDOF);
                 plate.evaluate(0, &v, &mut ws, &mut residual, false);
+                // the kernel compiled for baseline x86-64 (what `evaluate` runs without AVX2)
+                let mut baseline = LocalSystem::with_preconditioner(NDOF);
+                plate.evaluate_kernel(0, &v, &mut ws, &mut baseline, true);
                 for (what, err) in [
                     ("residual", rel(&out.residual, &r)),
                     ("residual alone", rel(&residual.residual, &r)),
                     ("tangent", rel(&out.tangent, &k)),
                     ("tangent alone", rel(&alone.tangent, &k)),
                     ("P", rel(&out.preconditioner, &p)),
+                    ("baseline residual", rel(&baseline.residual, &r)),
+                    ("baseline tangent", rel(&baseline.tangent, &k)),
+                    ("baseline P", rel(&baseline.preconditioner, &p)),
                     ("energy", rel(&[out.energy, residual.energy], &[energy, energy])),
                 ] {
                     assert!(err < 1e-12, "{kin:?}, parallelogram {}: {what} differs by {err:e}", coords == parallelogram);
