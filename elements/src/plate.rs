@@ -245,25 +245,23 @@ impl PlateElements {
         let geo = &self.geometry[e];
         let h = self.section.thickness();
         let nonlinear = self.kinematics == Kinematics::Nonlinear;
-        let fibre = |n: &[f64; 4]| fibre(n, h, v);
-        let tangent = |g0: [f64; 2], dn: [f64; 4], face: usize| face_tangent(g0, dn, face, v);
+        // (no closures: they would not be inlined into the AVX2 build)
         let s = &mut ws.samples;
-        let mut put = |id: usize, scale: f64, a: &Affine, b: &Affine, full: bool| put(&mut s[id], full && nonlinear, scale, a, b);
         // the reference frame's orientation: det[G1, G2, G3] with G3 = e3
         let reference = geo.frame[0][0] * geo.frame[1][1] - geo.frame[0][1] * geo.frame[1][0];
         let mut volume_ratio = f64::INFINITY;
         for g in 0..4 {
-            let g3 = fibre(&geo.n[g]);
-            put(E33 + g, 0.5, &g3, &g3, true);
+            let g3 = fibre(&geo.n[g], h, v);
+            put(&mut s[E33 + g], nonlinear, 0.5, &g3, &g3);
+            let dn = geo.dndy[g];
             for face in 0..2 {
-                let dn = |i: usize| [geo.dndy[g][0][i], geo.dndy[g][1][i], geo.dndy[g][2][i], geo.dndy[g][3][i]];
-                let g1 = tangent(geo.frame[0], dn(0), face);
-                let g2 = tangent(geo.frame[1], dn(1), face);
+                let g1 = face_tangent(geo.frame[0], [dn[0][0], dn[1][0], dn[2][0], dn[3][0]], face, v);
+                let g2 = face_tangent(geo.frame[1], [dn[0][1], dn[1][1], dn[2][1], dn[3][1]], face, v);
                 volume_ratio = volume_ratio.min(triple(&g1.g, &g2.g, &g3.g) / reference);
                 let base = MEM + g * 6 + face * 3;
-                put(base, 0.5, &g1, &g1, true);
-                put(base + 1, 0.5, &g2, &g2, true);
-                put(base + 2, 1.0, &g1, &g2, true);
+                put(&mut s[base], nonlinear, 0.5, &g1, &g1);
+                put(&mut s[base + 1], nonlinear, 0.5, &g2, &g2);
+                put(&mut s[base + 2], nonlinear, 1.0, &g1, &g2);
             }
         }
         ws.volume_ratio = volume_ratio;
@@ -271,10 +269,10 @@ impl PlateElements {
             // only the shear samples this element's interpolation uses (see terms())
             let sp = if geo.parallelogram { &geo.line[pt] } else { &geo.tying[pt] };
             let base = if geo.parallelogram { LINE } else { TYING };
-            let g3 = fibre(&sp.n);
+            let g3 = fibre(&sp.n, h, v);
             for face in 0..2 {
-                let gt = tangent(sp.base, sp.dn, face);
-                put(base + pt * 2 + face, 1.0, &gt, &g3, true);
+                let gt = face_tangent(sp.base, sp.dn, face, v);
+                put(&mut s[base + pt * 2 + face], nonlinear, 1.0, &gt, &g3);
             }
         }
     }
@@ -350,11 +348,23 @@ impl Element for PlateElements {
     /// [`PlateElements::smallest_volume_ratio`]; it still computes the residual and tangent there,
     /// which the tangent tests use); the linear theory has no such limit.
     fn evaluate(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { self.evaluate_avx2(e, v, ws, out, with_tangent) };
+        }
         self.evaluate_kernel(e, v, ws, out, with_tangent)
     }
 }
 
 impl PlateElements {
+    /// [`Element::evaluate`] compiled for AVX2 (no FMA: the same operations, the same results).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn evaluate_avx2(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_kernel(e, v, ws, out, with_tangent)
+    }
+
     #[inline(always)]
     fn evaluate_kernel(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
         self.compute_samples(e, v, ws);
