@@ -365,6 +365,7 @@ impl PlateElements {
         self.evaluate_kernel(e, v, ws, out, with_tangent)
     }
 
+    /// The body of [`Element::evaluate`], inlined into the baseline and the AVX2 builds.
     #[inline(always)]
     fn evaluate_kernel(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
         self.compute_samples(e, v, ws);
