@@ -426,7 +426,8 @@ mod element_measurement {
     //! Not a test: the plate element's kernel alone (no scatter), every element of the bench mesh
     //! evaluated on one thread at a deformed state: tangent and preconditioner, tangent, residual only;
     //! the minimum of 15 sweeps (ignored; run with
-    //! `STAMP_ELEMENT_SIZES=100 cargo test --release -p stamp-cli --lib element_kernel -- --ignored --nocapture`).
+    //! `STAMP_ELEMENT_SIZES=100 cargo test --release -p stamp-cli --lib element_kernel -- --ignored --nocapture`;
+    //! STAMP_ELEMENT_ORDER picks the sweeps and their order).
     use super::*;
     use stamp::element::{Element, LocalSystem};
 
@@ -461,6 +462,19 @@ mod element_measurement {
                     })
                     .fold(f64::INFINITY, f64::min)
             };
+            // STAMP_ELEMENT_ORDER=tr, say: only these sweeps, in this order (p tangent and
+            // preconditioner, t tangent, r residual), e.g. to see whether one sweep slows the next
+            if let Ok(order) = std::env::var("STAMP_ELEMENT_ORDER") {
+                for ch in order.chars() {
+                    let (t, p) = match ch {
+                        'p' => (true, true),
+                        't' => (true, false),
+                        _ => (false, false),
+                    };
+                    println!("n {n}, sweep {ch}: {:.3} microseconds per element", 1e6 * sweep(t, p));
+                }
+                continue;
+            }
             let (full, tangent, residual) = (sweep(true, true), sweep(true, false), sweep(false, false));
             println!(
                 "n {n}: {} elements, microseconds per element: tangent and preconditioner {:.3}, tangent {:.3}, residual only {:.3}",

@@ -57,7 +57,6 @@ const E33: usize = 24; // + g
 const LINE: usize = 28; // + pt*2 + face: full covariant shear on the lines (parallelograms)
 const TYING: usize = 36; // + pt*2 + face: full covariant shear at the edge midpoints (other quads)
 const NSAMPLE: usize = 44;
-const NQUAD: usize = 44; // samples with a Hessian (nonlinear kinematics)
 /// Per membrane strain kind (E11, E22, E12) and Gauss point, the first Gauss point of its
 /// projection group (same xi2, same xi1, all; see [`crate::geometry`]'s `proj`).
 const MEMBRANE_GROUP_FIRST: [[usize; 4]; 3] = [[0, 0, 2, 2], [0, 1, 1, 0], [0, 0, 0, 0]];
@@ -67,6 +66,61 @@ const E33_ROW: usize = crate::material::idx::E33;
 /// a . (b x c)
 fn triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
     a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
+}
+
+/// Mark the upper halves of the vector registers clean (`vzeroupper`) after a faer product.
+///
+/// faer's matrix products run hand-written AVX-512 / AVX2 micro-kernels (the gemm crate's assembly)
+/// that return without `vzeroupper`. This crate is compiled for baseline x86-64 (legacy-encoded SSE2),
+/// and with the upper state dirty every such instruction has to merge into the full-width register,
+/// so it waits on the previous value of its destination: the independent chains of the code that
+/// follows become one long dependency chain. Measured: the tangent without P (whose path had no
+/// other call that cleans the state) 9.4 instead of 3.5 us per element, and a residual-only sweep
+/// after it 5.0 instead of 1.8 us, since the state stays dirty until something clears it.
+#[inline]
+fn clean_upper_vector_state() {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the CPU has AVX.
+        unsafe { zero_upper() }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+unsafe fn zero_upper() {
+    std::arch::x86_64::_mm256_zeroupper()
+}
+
+/// The deformed transverse fibre g3 = e3 + (v+ - v-)/h at the point with shape functions `n`.
+#[inline(always)]
+fn fibre(n: &[f64; 4], h: f64, v: &[f64]) -> Affine {
+    let mut c = [0.0; NPAIR];
+    for a in 0..4 {
+        c[2 * a] = -n[a] / h;
+        c[2 * a + 1] = n[a] / h;
+    }
+    Affine::new([0.0, 0.0, 1.0], c, v)
+}
+
+/// The deformed tangent g0 + v_face,a of a face, `dn` the shape-function derivatives along it.
+#[inline(always)]
+fn face_tangent(g0: [f64; 2], dn: [f64; 4], face: usize, v: &[f64]) -> Affine {
+    let mut c = [0.0; NPAIR];
+    for a in 0..4 {
+        c[2 * a + face] = dn[a];
+    }
+    Affine::new([g0[0], g0[1], 0.0], c, v)
+}
+
+/// The strain s gA . gB - its reference value, full or linear part.
+#[inline(always)]
+fn put(sample: &mut Sample, full: bool, scale: f64, a: &Affine, b: &Affine) {
+    if full {
+        sample.quadratic(scale, a, b)
+    } else {
+        sample.linear(scale, a, b)
+    }
 }
 
 /// Per-thread scratch memory of the plate element.
@@ -80,6 +134,9 @@ pub struct PlateWorkspace {
     /// tangent's one-way coupling (b_ab33 = 0, b_33ab != 0).
     coupling: [[f64; NDOF]; 4],
     mu: [f64; NSAMPLE],
+    /// The (sample, coefficient) terms of every assumed strain at every Gauss point (of a shared
+    /// membrane strain: at the first point of its group only).
+    terms: [[Terms; NSTRAIN]; 4],
     /// The smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] of the faces at the Gauss
     /// points found by the last `compute_samples` (see [`PlateElements::smallest_volume_ratio`]).
     volume_ratio: f64,
@@ -97,6 +154,8 @@ pub struct PlateElements {
     cells: Vec<[usize; 4]>,
     geometry: Vec<ElementGeometry>,
     d: [[f64; NSTRAIN]; NSTRAIN],
+    /// The nonzero entries (column, value) of every row of D.
+    d_rows: [([(usize, f64); NSTRAIN], usize); NSTRAIN],
     section: Section,
     kinematics: Kinematics,
     /// D has the one-way coupling of T33 to the in-plane strains (nu != 0): the tangent is not
@@ -104,8 +163,9 @@ pub struct PlateElements {
     coupled: bool,
 }
 
-/// Up to 8 (sample, coefficient) terms of an assumed strain.
-type Terms = ([(usize, f64); 8], usize);
+/// Up to 4 (sample, coefficient) terms of an assumed strain (4 projection weights of a membrane
+/// strain, 2 covariant components times 1 line or 2 tying samples of a shear strain).
+type Terms = ([(usize, f64); 4], usize);
 
 impl PlateElements {
     /// Plate elements on every cell of `mesh`, with a validated section.
@@ -115,7 +175,14 @@ impl PlateElements {
         let geometry = (0..mesh.num_cells()).map(|c| ElementGeometry::new(&mesh.cell_coords(c), c)).collect::<Result<Vec<_>>>()?;
         let d = section.stiffness();
         let coupled = (0..NSTRAIN).any(|c| c != E33_ROW && d[E33_ROW][c] != 0.0);
-        Ok(PlateElements { cells: mesh.cells.clone(), geometry, d, section, kinematics, coupled })
+        let mut d_rows = [([(0, 0.0); NSTRAIN], 0); NSTRAIN];
+        for (r, (entries, n)) in d_rows.iter_mut().enumerate() {
+            for c in (0..NSTRAIN).filter(|&c| d[r][c] != 0.0) {
+                entries[*n] = (c, d[r][c]);
+                *n += 1;
+            }
+        }
+        Ok(PlateElements { cells: mesh.cells.clone(), geometry, d, d_rows, section, kinematics, coupled })
     }
 
     pub fn section(&self) -> &Section {
@@ -133,14 +200,16 @@ impl PlateElements {
         &self.geometry[e]
     }
 
-    /// The (sample, coefficient) terms of assumed strain component `c` at Gauss point `g`.
-    fn terms(geo: &ElementGeometry, g: usize, c: usize) -> Terms {
-        let mut t = [(0usize, 0.0); 8];
-        let mut n = 0;
+    /// The (sample, coefficient) terms of assumed strain component `c` at Gauss point `g`, written
+    /// in place (a returned copy was read back before its stores had retired: store-forwarding stalls).
+    #[inline(always)]
+    fn terms(geo: &ElementGeometry, g: usize, c: usize, out: &mut Terms) {
+        let (t, n) = out;
+        *n = 0;
         let mut push = |s: usize, w: f64| {
             if w != 0.0 {
-                t[n] = (s, w);
-                n += 1;
+                t[*n] = (s, w);
+                *n += 1;
             }
         };
         let face = c % 2;
@@ -168,52 +237,31 @@ impl PlateElements {
             }
             _ => push(E33 + g, 1.0),
         }
-        (t, n)
     }
 
     /// Evaluate every displacement-based strain sample of element e at local dofs `v`.
+    #[inline(always)]
     fn compute_samples(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace) {
         let geo = &self.geometry[e];
         let h = self.section.thickness();
         let nonlinear = self.kinematics == Kinematics::Nonlinear;
-        let fibre = |n: &[f64; 4]| {
-            let mut c = [0.0; NPAIR];
-            for a in 0..4 {
-                c[2 * a] = -n[a] / h;
-                c[2 * a + 1] = n[a] / h;
-            }
-            Affine::new([0.0, 0.0, 1.0], c, v)
-        };
-        let tangent = |g0: [f64; 2], dn: [f64; 4], face: usize| {
-            let mut c = [0.0; NPAIR];
-            for a in 0..4 {
-                c[2 * a + face] = dn[a];
-            }
-            Affine::new([g0[0], g0[1], 0.0], c, v)
-        };
+        // (no closures: they would not be inlined into the AVX2 build)
         let s = &mut ws.samples;
-        let mut put = |id: usize, scale: f64, a: &Affine, b: &Affine, full: bool| {
-            if full && nonlinear {
-                s[id].quadratic(scale, a, b)
-            } else {
-                s[id].linear(scale, a, b)
-            }
-        };
         // the reference frame's orientation: det[G1, G2, G3] with G3 = e3
         let reference = geo.frame[0][0] * geo.frame[1][1] - geo.frame[0][1] * geo.frame[1][0];
         let mut volume_ratio = f64::INFINITY;
         for g in 0..4 {
-            let g3 = fibre(&geo.n[g]);
-            put(E33 + g, 0.5, &g3, &g3, true);
+            let g3 = fibre(&geo.n[g], h, v);
+            put(&mut s[E33 + g], nonlinear, 0.5, &g3, &g3);
+            let dn = geo.dndy[g];
             for face in 0..2 {
-                let dn = |i: usize| [geo.dndy[g][0][i], geo.dndy[g][1][i], geo.dndy[g][2][i], geo.dndy[g][3][i]];
-                let g1 = tangent(geo.frame[0], dn(0), face);
-                let g2 = tangent(geo.frame[1], dn(1), face);
+                let g1 = face_tangent(geo.frame[0], [dn[0][0], dn[1][0], dn[2][0], dn[3][0]], face, v);
+                let g2 = face_tangent(geo.frame[1], [dn[0][1], dn[1][1], dn[2][1], dn[3][1]], face, v);
                 volume_ratio = volume_ratio.min(triple(&g1.g, &g2.g, &g3.g) / reference);
                 let base = MEM + g * 6 + face * 3;
-                put(base, 0.5, &g1, &g1, true);
-                put(base + 1, 0.5, &g2, &g2, true);
-                put(base + 2, 1.0, &g1, &g2, true);
+                put(&mut s[base], nonlinear, 0.5, &g1, &g1);
+                put(&mut s[base + 1], nonlinear, 0.5, &g2, &g2);
+                put(&mut s[base + 2], nonlinear, 1.0, &g1, &g2);
             }
         }
         ws.volume_ratio = volume_ratio;
@@ -221,10 +269,10 @@ impl PlateElements {
             // only the shear samples this element's interpolation uses (see terms())
             let sp = if geo.parallelogram { &geo.line[pt] } else { &geo.tying[pt] };
             let base = if geo.parallelogram { LINE } else { TYING };
-            let g3 = fibre(&sp.n);
+            let g3 = fibre(&sp.n, h, v);
             for face in 0..2 {
-                let gt = tangent(sp.base, sp.dn, face);
-                put(base + pt * 2 + face, 1.0, &gt, &g3, true);
+                let gt = face_tangent(sp.base, sp.dn, face, v);
+                put(&mut s[base + pt * 2 + face], nonlinear, 1.0, &gt, &g3);
             }
         }
     }
@@ -248,7 +296,9 @@ impl PlateElements {
         let mut out = GaussState::default();
         for g in 0..4 {
             for c in 0..NSTRAIN {
-                let (t, n) = Self::terms(geo, g, c);
+                let mut terms = ([(0, 0.0); 4], 0);
+                Self::terms(geo, g, c, &mut terms);
+                let (t, n) = terms;
                 out.strain[g][c] = t[..n].iter().map(|&(s, w)| w * ws.samples[s].val).sum();
             }
             for r in 0..NSTRAIN {
@@ -289,6 +339,7 @@ impl Element for PlateElements {
             db: [[0.0; NDOF]; 4 * NSTRAIN],
             coupling: [[0.0; NDOF]; 4],
             mu: [0.0; NSAMPLE],
+            terms: [[([(0, 0.0); 4], 0); NSTRAIN]; 4],
             volume_ratio: 1.0,
         }
     }
@@ -297,6 +348,26 @@ impl Element for PlateElements {
     /// [`PlateElements::smallest_volume_ratio`]; it still computes the residual and tangent there,
     /// which the tangent tests use); the linear theory has no such limit.
     fn evaluate(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { self.evaluate_avx2(e, v, ws, out, with_tangent) };
+        }
+        self.evaluate_kernel(e, v, ws, out, with_tangent)
+    }
+}
+
+impl PlateElements {
+    /// [`Element::evaluate`] compiled for AVX2 (no FMA: the same operations, the same results).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn evaluate_avx2(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_kernel(e, v, ws, out, with_tangent)
+    }
+
+    /// The body of [`Element::evaluate`], inlined into the baseline and the AVX2 builds.
+    #[inline(always)]
+    fn evaluate_kernel(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
         self.compute_samples(e, v, ws);
         if self.kinematics == Kinematics::Nonlinear && ws.volume_ratio <= 0.0 {
             out.inadmissible = Some(format!(
@@ -308,9 +379,10 @@ impl Element for PlateElements {
         let d = &self.d;
         // P asked for and different from the tangent
         let split = with_tangent && self.coupled && !out.preconditioner.is_empty();
-        ws.mu = [0.0; NSAMPLE];
+        let PlateWorkspace { samples, b, db, coupling, mu, terms, .. } = ws;
+        let samples: &[Sample; NSAMPLE] = samples;
+        *mu = [0.0; NSAMPLE];
         let mut strains = [[0.0; NSTRAIN]; 4];
-        let mut all_terms = [[([(0usize, 0.0); 8], 0usize); NSTRAIN]; 4];
         for g in 0..4 {
             let w = geo.wdet[g];
             for c in 0..NSTRAIN {
@@ -318,103 +390,119 @@ impl Element for PlateElements {
                 // same at every point of its group: computed at the group's first point, copied
                 let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
                 if first < g {
-                    all_terms[g][c] = all_terms[first][c];
                     strains[g][c] = strains[first][c];
-                    ws.b[g * NSTRAIN + c] = ws.b[first * NSTRAIN + c];
                     continue;
                 }
-                all_terms[g][c] = Self::terms(geo, g, c);
-                let (t, n) = &all_terms[g][c];
-                let row = &mut ws.b[g * NSTRAIN + c];
-                *row = [0.0; NDOF];
-                let mut strain = 0.0;
-                for &(s, coef) in &t[..*n] {
-                    let smp = &ws.samples[s];
-                    strain += coef * smp.val;
-                    for (r, &gr) in row.iter_mut().zip(&smp.grad) {
-                        *r += coef * gr;
-                    }
-                }
-                strains[g][c] = strain;
+                Self::terms(geo, g, c, &mut terms[g][c]);
+                let (t, n) = &terms[g][c];
+                strains[g][c] = t[..*n].iter().fold(0.0, |sum, &(s, coef)| sum + coef * samples[s].val);
             }
             let strain = strains[g];
-            let terms = &all_terms[g];
-            let rows = &ws.b[g * NSTRAIN..(g + 1) * NSTRAIN];
             let mut stress = [0.0; NSTRAIN];
             for r in 0..NSTRAIN {
                 stress[r] = (0..NSTRAIN).map(|c| d[r][c] * strain[c]).sum();
             }
             out.energy += 0.5 * w * (0..NSTRAIN).map(|c| strain[c] * stress[c]).sum::<f64>();
+            // weights mu_s = sum over the assumed strains c that use sample s of w T_c coef_cs:
+            // of the sample gradients in the internal force, of the sample Hessians in the
+            // geometric stiffness
             for c in 0..NSTRAIN {
-                let f = w * stress[c];
-                for (r, &b) in out.residual.iter_mut().zip(&rows[c]) {
-                    *r += f * b;
-                }
-            }
-            if !with_tangent {
-                continue;
-            }
-            // w D B at this Gauss point; for P the row of T33 split into its own strain's part
-            // (kept in db: w D0 B, D0 symmetric) and the one-way coupling to the in-plane strains
-            for r in 0..NSTRAIN {
-                let mut row = [0.0; NDOF];
-                let mut coupling = [0.0; NDOF];
-                for c in 0..NSTRAIN {
-                    let drc = w * d[r][c];
-                    if drc != 0.0 {
-                        let target = if split && r == E33_ROW && c != E33_ROW { &mut coupling } else { &mut row };
-                        for (x, &b) in target.iter_mut().zip(&rows[c]) {
-                            *x += drc * b;
-                        }
-                    }
-                }
-                ws.db[g * NSTRAIN + r] = row;
-                if split && r == E33_ROW {
-                    ws.coupling[g] = coupling;
-                }
-            }
-            // weights of the sample Hessians in the geometric stiffness
-            for c in 0..NSTRAIN {
-                let (t, n) = &terms[c];
+                let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
+                let (t, n) = &terms[first][c];
                 for &(s, coef) in &t[..*n] {
-                    ws.mu[s] += w * stress[c] * coef;
+                    mu[s] += w * stress[c] * coef;
                 }
             }
+        }
+        // internal force sum_g w B_g^T T_g = sum_s mu_s dE_s/dV over the samples this element uses
+        // (sums in local arrays, kept in registers: no store-to-load chain through memory)
+        let shear = if geo.parallelogram { LINE } else { TYING };
+        let mut residual = [0.0; NDOF];
+        for s in (MEM..E33 + 4).chain(shear..shear + 8) {
+            axpy(&mut residual, mu[s], &samples[s].grad);
+        }
+        for (r, x) in out.residual.iter_mut().zip(residual) {
+            *r += x;
         }
         if !with_tangent {
             return;
         }
+        for g in 0..4 {
+            let w = geo.wdet[g];
+            // the rows dE_c/dV of B at this Gauss point (shared membrane rows copied)
+            for c in 0..NSTRAIN {
+                let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
+                if first < g {
+                    b[g * NSTRAIN + c] = b[first * NSTRAIN + c];
+                    continue;
+                }
+                let (t, n) = &terms[g][c];
+                let mut row = [0.0; NDOF];
+                for &(s, coef) in &t[..*n] {
+                    axpy(&mut row, coef, &samples[s].grad);
+                }
+                b[g * NSTRAIN + c] = row;
+            }
+            // w D B at this Gauss point; for P the row of T33 split into its own strain's part
+            // (kept in db: w D0 B, D0 symmetric) and the one-way coupling to the in-plane strains
+            let rows = &b[g * NSTRAIN..(g + 1) * NSTRAIN];
+            for r in 0..NSTRAIN {
+                let (mut row, mut cpl) = ([0.0; NDOF], [0.0; NDOF]);
+                for &(c, drc) in &self.d_rows[r].0[..self.d_rows[r].1] {
+                    if split && r == E33_ROW && c != E33_ROW {
+                        axpy(&mut cpl, w * drc, &rows[c]);
+                    } else {
+                        axpy(&mut row, w * drc, &rows[c]);
+                    }
+                }
+                db[g * NSTRAIN + r] = row;
+                if split && r == E33_ROW {
+                    coupling[g] = cpl;
+                }
+            }
+        }
         // material stiffness: sum over the Gauss points of B^T (w D0 B), one 24 x 44 x 24 product,
         // and of the coupling b33^T (w c^T B_in): P gets the first, the tangent both
-        let b = MatRef::from_row_major_slice(ws.b.as_flattened(), 4 * NSTRAIN, NDOF);
-        let db = MatRef::from_row_major_slice(ws.db.as_flattened(), 4 * NSTRAIN, NDOF);
+        let bm = MatRef::from_row_major_slice(b.as_flattened(), 4 * NSTRAIN, NDOF);
+        let dbm = MatRef::from_row_major_slice(db.as_flattened(), 4 * NSTRAIN, NDOF);
         let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..NDOF * NDOF], NDOF, NDOF);
-        matmul(k, Accum::Add, b.transpose(), db, 1.0, Par::Seq);
+        matmul(k, Accum::Add, bm.transpose(), dbm, 1.0, Par::Seq);
+        clean_upper_vector_state();
         if split {
             out.preconditioner[..NDOF * NDOF].copy_from_slice(&out.tangent[..NDOF * NDOF]);
             // the rows dE33/dV of the four Gauss points: every NSTRAIN-th row of B
-            let b33 = MatRef::from_row_major_slice_with_stride(&ws.b.as_flattened()[E33_ROW * NDOF..], 4, NDOF, NSTRAIN * NDOF);
-            let coupling = MatRef::from_row_major_slice(ws.coupling.as_flattened(), 4, NDOF);
+            let b33 = MatRef::from_row_major_slice_with_stride(&b.as_flattened()[E33_ROW * NDOF..], 4, NDOF, NSTRAIN * NDOF);
+            let cm = MatRef::from_row_major_slice(coupling.as_flattened(), 4, NDOF);
             let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..NDOF * NDOF], NDOF, NDOF);
-            matmul(k, Accum::Add, b33.transpose(), coupling, 1.0, Par::Seq);
+            matmul(k, Accum::Add, b33.transpose(), cm, 1.0, Par::Seq);
+            clean_upper_vector_state();
         }
         // geometric stiffness: sum_s mu_s Hess_s (x) I3, Hess_s = scale (a b^T + b a^T)
         if self.kinematics == Kinematics::Nonlinear {
-            // X = sum_s mu_s scale_s a_s b_s^T, and H = X + X^T
+            // X = sum_s mu_s scale_s a_s b_s^T, and H = X + X^T; a_s and b_s of a membrane sample
+            // have nonzeros only at the pairs of its face, a_s of a shear sample likewise
             let mut x = [[0.0; NPAIR]; NPAIR];
-            for (smp, &m) in ws.samples[..NQUAD].iter().zip(&ws.mu[..NQUAD]) {
-                let f = m * smp.scale;
-                if f == 0.0 {
-                    continue;
-                }
-                for kk in 0..NPAIR {
+            let face_pairs = |face: usize| [face, face + 2, face + 4, face + 6];
+            let mut add = |s: usize, rows: &[usize], cols: &[usize]| {
+                let smp = &samples[s];
+                let f = mu[s] * smp.scale;
+                for &kk in rows {
                     let fa = f * smp.a[kk];
-                    if fa != 0.0 {
-                        for (xl, &bl) in x[kk].iter_mut().zip(&smp.b) {
-                            *xl += fa * bl;
-                        }
+                    for &l in cols {
+                        x[kk][l] += fa * smp.b[l];
                     }
                 }
+            };
+            let all: [usize; NPAIR] = std::array::from_fn(|k| k);
+            for s in MEM..E33 {
+                let pairs = face_pairs((s - MEM) % 6 / 3);
+                add(s, &pairs, &pairs);
+            }
+            for s in E33..E33 + 4 {
+                add(s, &all, &all);
+            }
+            for s in shear..shear + 8 {
+                add(s, &face_pairs(s % 2), &all);
             }
             for kk in 0..NPAIR {
                 for l in 0..NPAIR {
@@ -430,6 +518,14 @@ impl Element for PlateElements {
                 }
             }
         }
+    }
+}
+
+/// y += a x over the element dofs (fixed size and distinct borrows: vectorised, no bounds checks).
+#[inline(always)]
+fn axpy(y: &mut [f64; NDOF], a: f64, x: &[f64; NDOF]) {
+    for (yi, &xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
     }
 }
 
@@ -451,6 +547,112 @@ mod tests {
                     if MEMBRANE_GROUP_FIRST[kind][h] != first {
                         assert_ne!(geo.proj[kind][g], geo.proj[kind][h], "kind {kind}, Gauss points {g} and {h}");
                     }
+                }
+            }
+        }
+    }
+
+    /// The element computed the plain way (as first written): dense rows B_g of the assumed strains,
+    /// r = sum_g B_g^T w D E_g, K = sum_g B_g^T w D B_g + sum_s mu_s Hess_s (x) I3, and P the same
+    /// with D0 = D without `D[E33][in-plane]`; the fast kernel must agree to round-off.
+    fn reference(plate: &PlateElements, v: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>, f64) {
+        let mut ws = plate.new_workspace();
+        plate.compute_samples(0, v, &mut ws);
+        let (geo, d, smp) = (&plate.geometry[0], &plate.d, &ws.samples);
+        let (mut r, mut k, mut p, mut energy) = (vec![0.0; NDOF], vec![0.0; NDOF * NDOF], vec![0.0; NDOF * NDOF], 0.0);
+        let mut mu = [0.0; NSAMPLE];
+        for g in 0..4 {
+            let w = geo.wdet[g];
+            let mut terms = [([(0, 0.0); 4], 0); NSTRAIN];
+            let (mut b, mut strain) = ([[0.0; NDOF]; NSTRAIN], [0.0; NSTRAIN]);
+            for c in 0..NSTRAIN {
+                PlateElements::terms(geo, g, c, &mut terms[c]);
+                for &(s, coef) in &terms[c].0[..terms[c].1] {
+                    strain[c] += coef * smp[s].val;
+                    for i in 0..NDOF {
+                        b[c][i] += coef * smp[s].grad[i];
+                    }
+                }
+            }
+            let stress: Vec<f64> = (0..NSTRAIN).map(|rr| (0..NSTRAIN).map(|c| d[rr][c] * strain[c]).sum()).collect();
+            energy += 0.5 * w * (0..NSTRAIN).map(|c| strain[c] * stress[c]).sum::<f64>();
+            for c in 0..NSTRAIN {
+                for i in 0..NDOF {
+                    r[i] += w * stress[c] * b[c][i];
+                }
+                for &(s, coef) in &terms[c].0[..terms[c].1] {
+                    mu[s] += w * stress[c] * coef;
+                }
+                for rr in 0..NSTRAIN {
+                    for i in 0..NDOF {
+                        for j in 0..NDOF {
+                            let kij = b[rr][i] * w * d[rr][c] * b[c][j];
+                            k[i * NDOF + j] += kij;
+                            if !(rr == E33_ROW && c != E33_ROW) {
+                                p[i * NDOF + j] += kij;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if plate.kinematics == Kinematics::Nonlinear {
+            for s in 0..NSAMPLE {
+                for kk in 0..NPAIR {
+                    for l in 0..NPAIR {
+                        for i in 0..3 {
+                            k[(3 * kk + i) * NDOF + 3 * l + i] += mu[s] * smp[s].hessian(kk, l);
+                            p[(3 * kk + i) * NDOF + 3 * l + i] += mu[s] * smp[s].hessian(kk, l);
+                        }
+                    }
+                }
+            }
+        }
+        (r, k, p, energy)
+    }
+
+    /// The kernel (sample-weighted internal force, shared membrane rows, sparse D, geometric
+    /// stiffness over the face pairs; AVX2 and baseline builds) against the plain computation, on a distorted element (tying
+    /// shear) and a parallelogram (line shear), both kinematics, at a large-displacement state.
+    #[test]
+    fn kernel_agrees_with_the_plain_computation() {
+        use stamp::mesh::QuadMesh;
+        let distorted = [[0.0, 0.0], [2.0, 0.3], [2.6, 1.9], [-0.4, 1.2]];
+        let parallelogram = [[0.0, 0.0], [2.0, 0.3], [2.5, 1.5], [0.5, 1.2]];
+        let section = Section::homogeneous(0.15, crate::Isotropic::new(2.0e5, 0.3).unwrap()).unwrap();
+        let v: Vec<f64> = (0..NDOF).map(|k| 0.6 * ((k * 7919 % 1000) as f64 / 500.0 - 1.0)).collect();
+        let rel = |a: &[f64], b: &[f64]| {
+            let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+        };
+        for coords in [distorted, parallelogram] {
+            for kin in [Kinematics::Nonlinear, Kinematics::Linear] {
+                let mesh = QuadMesh::new(coords.to_vec(), vec![[0, 1, 2, 3]]).unwrap();
+                let plate = PlateElements::new(&mesh, section.clone(), kin).unwrap();
+                assert_eq!(plate.geometry(0).parallelogram, coords == parallelogram);
+                let (r, k, p, energy) = reference(&plate, &v);
+                let mut ws = plate.new_workspace();
+                let mut out = LocalSystem::with_preconditioner(NDOF);
+                plate.evaluate(0, &v, &mut ws, &mut out, true);
+                let mut alone = LocalSystem::new(NDOF);
+                plate.evaluate(0, &v, &mut ws, &mut alone, true);
+                let mut residual = LocalSystem::new(NDOF);
+                plate.evaluate(0, &v, &mut ws, &mut residual, false);
+                // the kernel compiled for baseline x86-64 (what `evaluate` runs without AVX2)
+                let mut baseline = LocalSystem::with_preconditioner(NDOF);
+                plate.evaluate_kernel(0, &v, &mut ws, &mut baseline, true);
+                for (what, err) in [
+                    ("residual", rel(&out.residual, &r)),
+                    ("residual alone", rel(&residual.residual, &r)),
+                    ("tangent", rel(&out.tangent, &k)),
+                    ("tangent alone", rel(&alone.tangent, &k)),
+                    ("P", rel(&out.preconditioner, &p)),
+                    ("baseline residual", rel(&baseline.residual, &r)),
+                    ("baseline tangent", rel(&baseline.tangent, &k)),
+                    ("baseline P", rel(&baseline.preconditioner, &p)),
+                    ("energy", rel(&[out.energy, residual.energy], &[energy, energy])),
+                ] {
+                    assert!(err < 1e-12, "{kin:?}, parallelogram {}: {what} differs by {err:e}", coords == parallelogram);
                 }
             }
         }

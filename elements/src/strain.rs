@@ -25,6 +25,7 @@ pub struct Affine {
 
 impl Affine {
     /// Build from the reference vector and the coefficients, evaluating g at `v`.
+    #[inline(always)]
     pub fn new(g0: [f64; 3], c: [f64; NPAIR], v: &[f64]) -> Self {
         let mut g = g0;
         for k in 0..NPAIR {
@@ -56,13 +57,14 @@ impl Default for Sample {
     }
 }
 
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 impl Sample {
     /// The full (Green-Lagrange) strain s (gA . gB - g0A . g0B).
+    #[inline(always)]
     pub fn quadratic(&mut self, s: f64, a: &Affine, b: &Affine) {
         self.val = s * (dot(&a.g, &b.g) - dot(&a.g0, &b.g0));
         for k in 0..NPAIR {
@@ -82,6 +84,7 @@ impl Sample {
 
     /// The part linear in the displacements, s (g0A . dB + g0B . dA) with d = g - g0: the strain of
     /// the geometrically linear theory (eta = 0). Its Hessian is zero.
+    #[inline(always)]
     pub fn linear(&mut self, s: f64, a: &Affine, b: &Affine) {
         let da = [a.g[0] - a.g0[0], a.g[1] - a.g0[1], a.g[2] - a.g0[2]];
         let db = [b.g[0] - b.g0[0], b.g[1] - b.g0[1], b.g[2] - b.g0[2]];
