@@ -189,7 +189,11 @@ impl Assembler {
         let eqs = dofs.equations();
         let mut energy = 0.0;
         let local_system = || if with_preconditioner { LocalSystem::with_preconditioner(nloc) } else { LocalSystem::new(nloc) };
-        let init = || (element.new_workspace(), local_system(), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc]);
+        // (a worker thread may come from faer's kernels: see crate::vector_state)
+        let init = || {
+            crate::vector_state::clean_upper_vector_state();
+            (element.new_workspace(), local_system(), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc])
+        };
         // per-thread scratch: workspace, local system, local values, global dofs, row ranks
         // per element: its energy, and its number if it refused the state (usize::MAX if not)
         let kernel = |st: &mut (E::Workspace, LocalSystem, Vec<f64>, Vec<usize>, Vec<u32>), e: usize| -> (f64, usize) {

@@ -346,6 +346,7 @@ impl LdltGmres {
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         let s = SparseColMatRef::new(pattern, values.unwrap_or(&self.symmetric_values));
         let ok = sym.factorize_numeric_ldlt(&mut self.factor, s, Side::Lower, LdltRegularization::default(), par, MemStack::new(buffer), Default::default()).is_ok();
+        crate::vector_state::clean_upper_vector_state();
         ok && pivots(sym, &self.factor).all(|d| d.is_finite() && d != 0.0)
     }
 
@@ -353,6 +354,7 @@ impl LdltGmres {
     fn ldlt_solve(symbolic: &SymbolicCholesky<usize>, factor: &[f64], buffer: &mut MemBuffer, par: Par, x: &mut [f64]) {
         let n = x.len();
         LdltRef::new(symbolic, factor).solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, n, 1), par, MemStack::new(buffer));
+        crate::vector_state::clean_upper_vector_state();
     }
 
     /// The direct solve with iterative refinement; returns the backward error reached.
@@ -459,6 +461,7 @@ const ROWS_PER_TASK: usize = 4096;
 fn split_values(col_ptr: &[usize], transpose: &[usize], a: &[f64], row_values: &mut [f64], symmetric: Option<&mut [f64]>, row_sums: &mut [f64], parallel: bool) -> (f64, f64) {
     // the columns first..first + sums.len(), whose entries start at slot `base`
     let columns = |first: usize, base: usize, rows: &mut [f64], mut sym: Option<&mut [f64]>, sums: &mut [f64]| {
+        crate::vector_state::clean_upper_vector_state();
         let (mut worst, mut size) = (0.0f64, 0.0f64);
         for (c, sum) in sums.iter_mut().enumerate() {
             let mut total = 0.0;
@@ -512,6 +515,8 @@ fn split_values(col_ptr: &[usize], transpose: &[usize], a: &[f64], row_values: &
 /// y_c = sum_k row_values[k] x[row_idx[k]] over column c. Rows in parallel when `parallel`.
 fn multiply_rows(col_ptr: &[usize], row_idx: &[usize], row_values: &[f64], x: &[f64], y: &mut [f64], parallel: bool) {
     let rows = |first: usize, out: &mut [f64]| {
+        // a worker thread may come from faer's kernels (see crate::vector_state)
+        crate::vector_state::clean_upper_vector_state();
         for (i, yi) in out.iter_mut().enumerate() {
             let c = first + i;
             *yi = (col_ptr[c]..col_ptr[c + 1]).map(|k| row_values[k] * x[row_idx[k]]).sum();

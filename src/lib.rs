@@ -21,6 +21,7 @@ pub mod ordering;
 pub mod bordered;
 pub mod sparse;
 pub mod assembly;
+pub mod vector_state;
 pub mod contact;
 pub mod model;
 pub mod nonlinear;

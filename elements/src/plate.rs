@@ -13,6 +13,7 @@ use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{Section, NSTRAIN};
 use crate::strain::{Affine, Sample, NDOF, NPAIR};
 use stamp::element::{Element, LocalSystem};
+use stamp::vector_state::clean_upper_vector_state;
 use stamp::mesh::QuadMesh;
 use stamp::Result;
 use faer::linalg::matmul::matmul;
@@ -66,30 +67,6 @@ const E33_ROW: usize = crate::material::idx::E33;
 /// a . (b x c)
 fn triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
     a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
-}
-
-/// Mark the upper halves of the vector registers clean (`vzeroupper`) after a faer product.
-///
-/// faer's matrix products run hand-written AVX-512 / AVX2 micro-kernels (the gemm crate's assembly)
-/// that return without `vzeroupper`. This crate is compiled for baseline x86-64 (legacy-encoded SSE2),
-/// and with the upper state dirty every such instruction has to merge into the full-width register,
-/// so it waits on the previous value of its destination: the independent chains of the code that
-/// follows become one long dependency chain. Measured: the tangent without P (whose path had no
-/// other call that cleans the state) 9.4 instead of 3.5 us per element, and a residual-only sweep
-/// after it 5.0 instead of 1.8 us, since the state stays dirty until something clears it.
-#[inline]
-fn clean_upper_vector_state() {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
-        // SAFETY: the CPU has AVX.
-        unsafe { zero_upper() }
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-unsafe fn zero_upper() {
-    std::arch::x86_64::_mm256_zeroupper()
 }
 
 /// The deformed transverse fibre g3 = e3 + (v+ - v-)/h at the point with shape functions `n`.
