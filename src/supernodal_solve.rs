@@ -570,11 +570,9 @@ fn lower_solve(l: &[f64], ld: usize, w: usize, y: &mut [f64]) {
         j += 4;
     }
     while j < w {
-        let c = &l[j * ld..(j + 1) * ld];
+        let c = &l[j * ld + j + 1..(j + 1) * ld];
         let a = y[j];
-        for (v, lv) in y[j + 1..].iter_mut().zip(&c[j + 1..]) {
-            *v -= lv * a;
-        }
+        axpy(c, a, &mut y[j + 1..]);
         j += 1;
     }
 }
@@ -584,8 +582,28 @@ fn lower_solve(l: &[f64], ld: usize, w: usize, y: &mut [f64]) {
 fn axpy4(c0: &[f64], c1: &[f64], c2: &[f64], c3: &[f64], a: [f64; 4], y: &mut [f64]) {
     let n = y.len();
     let (c0, c1, c2, c3) = (&c0[..n], &c1[..n], &c2[..n], &c3[..n]);
+    #[cfg(target_arch = "x86_64")]
+    if simd::available() {
+        // SAFETY: the CPU has AVX2 and FMA; all slices hold n entries
+        return unsafe { simd::axpy4(c0.as_ptr(), c1.as_ptr(), c2.as_ptr(), c3.as_ptr(), a, y.as_mut_ptr(), n) };
+    }
     for r in 0..n {
         y[r] -= c0[r] * a[0] + c1[r] * a[1] + c2[r] * a[2] + c3[r] * a[3];
+    }
+}
+
+/// y -= c a.
+#[inline]
+fn axpy(c: &[f64], a: f64, y: &mut [f64]) {
+    let n = c.len();
+    let y = &mut y[..n];
+    #[cfg(target_arch = "x86_64")]
+    if simd::available() {
+        // SAFETY: the CPU has AVX2 and FMA; both slices hold n entries
+        return unsafe { simd::axpy1(c.as_ptr(), a, y.as_mut_ptr(), n) };
+    }
+    for (v, lv) in y.iter_mut().zip(c) {
+        *v -= lv * a;
     }
 }
 
@@ -619,6 +637,11 @@ fn upper_solve(l: &[f64], ld: usize, w: usize, y: &mut [f64]) {
 fn dot(c: &[f64], y: &[f64]) -> f64 {
     let n = c.len();
     let y = &y[..n];
+    #[cfg(target_arch = "x86_64")]
+    if simd::available() {
+        // SAFETY: the CPU has AVX2 and FMA; both slices hold n entries
+        return unsafe { simd::dot4(c.as_ptr(), c.as_ptr(), c.as_ptr(), c.as_ptr(), y.as_ptr(), n, 1)[0] };
+    }
     let mut acc = [0.0f64; 4];
     let (cc, yc) = (c.chunks_exact(4), y.chunks_exact(4));
     let (cr, yr) = (cc.remainder(), yc.remainder());
@@ -639,21 +662,13 @@ fn dot(c: &[f64], y: &[f64]) -> f64 {
 fn dot4(c0: &[f64], c1: &[f64], c2: &[f64], c3: &[f64], y: &[f64]) -> [f64; 4] {
     let n = y.len();
     let (c0, c1, c2, c3) = (&c0[..n], &c1[..n], &c2[..n], &c3[..n]);
-    let mut acc = [[0.0f64; 4]; 4];
-    let full = n / 4 * 4;
-    let mut r = 0;
-    while r < full {
-        for k in 0..4 {
-            let v = y[r + k];
-            acc[0][k] += c0[r + k] * v;
-            acc[1][k] += c1[r + k] * v;
-            acc[2][k] += c2[r + k] * v;
-            acc[3][k] += c3[r + k] * v;
-        }
-        r += 4;
+    #[cfg(target_arch = "x86_64")]
+    if simd::available() {
+        // SAFETY: the CPU has AVX2 and FMA; all slices hold n entries
+        return unsafe { simd::dot4(c0.as_ptr(), c1.as_ptr(), c2.as_ptr(), c3.as_ptr(), y.as_ptr(), n, 4) };
     }
-    let mut s = acc.map(|a| (a[0] + a[1]) + (a[2] + a[3]));
-    for r in full..n {
+    let mut s = [0.0f64; 4];
+    for r in 0..n {
         let v = y[r];
         s[0] += c0[r] * v;
         s[1] += c1[r] * v;
@@ -663,6 +678,116 @@ fn dot4(c0: &[f64], c1: &[f64], c2: &[f64], c3: &[f64], y: &[f64]) -> [f64; 4] {
     s
 }
 
+/// AVX2 and FMA kernels (faer's own dense kernels dispatch to these instructions at run time
+/// too).
+#[cfg(target_arch = "x86_64")]
+mod simd {
+    use std::arch::x86_64::*;
+
+    #[inline]
+    pub fn available() -> bool {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+
+    /// y[r] -= c0[r] a0 + c1[r] a1 + c2[r] a2 + c3[r] a3 for r < n.
+    ///
+    /// # Safety
+    /// AVX2 and FMA; every pointer valid for n entries.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn axpy4(c0: *const f64, c1: *const f64, c2: *const f64, c3: *const f64, a: [f64; 4], y: *mut f64, n: usize) {
+        let (a0, a1, a2, a3) = (_mm256_set1_pd(a[0]), _mm256_set1_pd(a[1]), _mm256_set1_pd(a[2]), _mm256_set1_pd(a[3]));
+        let mut r = 0;
+        while r + 4 <= n {
+            let mut v = _mm256_loadu_pd(y.add(r));
+            v = _mm256_fnmadd_pd(_mm256_loadu_pd(c0.add(r)), a0, v);
+            v = _mm256_fnmadd_pd(_mm256_loadu_pd(c1.add(r)), a1, v);
+            v = _mm256_fnmadd_pd(_mm256_loadu_pd(c2.add(r)), a2, v);
+            v = _mm256_fnmadd_pd(_mm256_loadu_pd(c3.add(r)), a3, v);
+            _mm256_storeu_pd(y.add(r), v);
+            r += 4;
+        }
+        while r < n {
+            *y.add(r) -= *c0.add(r) * a[0] + *c1.add(r) * a[1] + *c2.add(r) * a[2] + *c3.add(r) * a[3];
+            r += 1;
+        }
+    }
+
+    /// y[r] -= c[r] a for r < n.
+    ///
+    /// # Safety
+    /// AVX2 and FMA; both pointers valid for n entries.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn axpy1(c: *const f64, a: f64, y: *mut f64, n: usize) {
+        let av = _mm256_set1_pd(a);
+        let mut r = 0;
+        while r + 4 <= n {
+            _mm256_storeu_pd(y.add(r), _mm256_fnmadd_pd(_mm256_loadu_pd(c.add(r)), av, _mm256_loadu_pd(y.add(r))));
+            r += 4;
+        }
+        while r < n {
+            *y.add(r) -= *c.add(r) * a;
+            r += 1;
+        }
+    }
+
+    /// The sums c_k[r] y[r] over r < n for the first `columns` (1 or 4) of c0..c3.
+    ///
+    /// # Safety
+    /// AVX2 and FMA; every pointer valid for n entries.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn dot4(c0: *const f64, c1: *const f64, c2: *const f64, c3: *const f64, y: *const f64, n: usize, columns: usize) -> [f64; 4] {
+        let hsum = |v: __m256d| {
+            let lo = _mm256_castpd256_pd128(v);
+            let hi = _mm256_extractf128_pd(v, 1);
+            let s = _mm_add_pd(lo, hi);
+            _mm_cvtsd_f64(_mm_add_pd(s, _mm_unpackhi_pd(s, s)))
+        };
+        if columns == 1 {
+            // two chains of four lanes
+            let (mut s0, mut s1) = (_mm256_setzero_pd(), _mm256_setzero_pd());
+            let mut r = 0;
+            while r + 8 <= n {
+                s0 = _mm256_fmadd_pd(_mm256_loadu_pd(c0.add(r)), _mm256_loadu_pd(y.add(r)), s0);
+                s1 = _mm256_fmadd_pd(_mm256_loadu_pd(c0.add(r + 4)), _mm256_loadu_pd(y.add(r + 4)), s1);
+                r += 8;
+            }
+            let mut s = hsum(_mm256_add_pd(s0, s1));
+            while r < n {
+                s += *c0.add(r) * *y.add(r);
+                r += 1;
+            }
+            return [s, 0.0, 0.0, 0.0];
+        }
+        // eight chains: two per column
+        let z = _mm256_setzero_pd();
+        let (mut a0, mut a1, mut a2, mut a3) = (z, z, z, z);
+        let (mut b0, mut b1, mut b2, mut b3) = (z, z, z, z);
+        let mut r = 0;
+        while r + 8 <= n {
+            let v = _mm256_loadu_pd(y.add(r));
+            let w = _mm256_loadu_pd(y.add(r + 4));
+            a0 = _mm256_fmadd_pd(_mm256_loadu_pd(c0.add(r)), v, a0);
+            a1 = _mm256_fmadd_pd(_mm256_loadu_pd(c1.add(r)), v, a1);
+            a2 = _mm256_fmadd_pd(_mm256_loadu_pd(c2.add(r)), v, a2);
+            a3 = _mm256_fmadd_pd(_mm256_loadu_pd(c3.add(r)), v, a3);
+            b0 = _mm256_fmadd_pd(_mm256_loadu_pd(c0.add(r + 4)), w, b0);
+            b1 = _mm256_fmadd_pd(_mm256_loadu_pd(c1.add(r + 4)), w, b1);
+            b2 = _mm256_fmadd_pd(_mm256_loadu_pd(c2.add(r + 4)), w, b2);
+            b3 = _mm256_fmadd_pd(_mm256_loadu_pd(c3.add(r + 4)), w, b3);
+            r += 8;
+        }
+        let mut s = [hsum(_mm256_add_pd(a0, b0)), hsum(_mm256_add_pd(a1, b1)), hsum(_mm256_add_pd(a2, b2)), hsum(_mm256_add_pd(a3, b3))];
+        while r < n {
+            let v = *y.add(r);
+            s[0] += *c0.add(r) * v;
+            s[1] += *c1.add(r) * v;
+            s[2] += *c2.add(r) * v;
+            s[3] += *c3.add(r) * v;
+            r += 1;
+        }
+        s
+    }
+}
 #[cfg(test)]
 mod tests {
     use super::*;
