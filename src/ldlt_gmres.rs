@@ -73,6 +73,7 @@ use crate::error::{Result, StampError};
 use crate::gmres::{Gmres, GmresReport};
 use crate::linear_solver::{parallelism_for, LinearSolver, SolverTimings, SparseLu};
 use crate::ordering;
+use crate::supernodal_solve::SupernodalSolve;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymmetricOrdering};
@@ -139,6 +140,9 @@ pub struct LdltGmresStats {
 /// LDL^T of the symmetric part, direct or as GMRES preconditioner; LU fallback.
 pub struct LdltGmres {
     symbolic: Option<SymbolicCholesky<usize>>,
+    /// The tree-parallel solve with a supernodal factor of `symbolic` (None: simplicial, faer's
+    /// solve), used unless the parallelism is sequential.
+    supernodal: Option<SupernodalSolve>,
     /// The ordering asked for, and the one the current symbolic factor uses (Amd or
     /// NestedDissection).
     ordering: Ordering,
@@ -198,6 +202,7 @@ impl LdltGmres {
     pub fn new() -> Self {
         LdltGmres {
             symbolic: None,
+            supernodal: None,
             ordering: Ordering::default(),
             ordering_used: None,
             factor: Vec::new(),
@@ -287,6 +292,7 @@ impl LdltGmres {
         self.symmetric_values = if self.transpose.is_some() { vec![0.0; nnz] } else { Vec::new() };
         self.row_values = if self.transpose.is_some() { vec![0.0; nnz] } else { Vec::new() };
         self.symbolic = None;
+        self.supernodal = None;
         self.ordering_used = None;
         self.factor_valid = false;
         if self.transpose.is_some() {
@@ -309,6 +315,7 @@ impl LdltGmres {
             let scratch = sym.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default()).or(sym.solve_in_place_scratch::<f64>(1, self.par));
             self.buffer = Some(MemBuffer::try_new(scratch).map_err(|_| StampError::LinearSolver("out of memory for the LDL^T workspace".into()))?);
             self.factor = vec![0.0; sym.len_val()];
+            self.supernodal = Some(SupernodalSolve::new(&sym)).filter(SupernodalSolve::is_parallel);
             self.symbolic = Some(sym);
         }
         self.timings.symbolic += t.elapsed().as_secs_f64();
@@ -346,24 +353,31 @@ impl LdltGmres {
         ok && self.factor.iter().all(|x| x.is_finite())
     }
 
-    /// x = S^-1 x with the LDL^T factor.
-    fn ldlt_solve(symbolic: &SymbolicCholesky<usize>, factor: &[f64], buffer: &mut MemBuffer, par: Par, x: &mut [f64]) {
-        let n = x.len();
-        LdltRef::new(symbolic, factor).solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, n, 1), par, MemStack::new(buffer));
+    /// x = S^-1 x with the LDL^T factor: by the tree-parallel solve `supernodal` (when given)
+    /// unless `par` is sequential, by faer's otherwise.
+    fn ldlt_solve(symbolic: &SymbolicCholesky<usize>, supernodal: Option<&SupernodalSolve>, factor: &[f64], buffer: &mut MemBuffer, par: Par, x: &mut [f64]) {
+        match supernodal {
+            Some(fast) if par != Par::Seq => fast.solve_in_place(symbolic, factor, x, true),
+            _ => {
+                let n = x.len();
+                LdltRef::new(symbolic, factor).solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, n, 1), par, MemStack::new(buffer));
+            }
+        }
     }
 
     /// The direct solve with iterative refinement; returns the backward error reached.
     fn direct_solve(&mut self, b: &mut [f64]) -> f64 {
         let par = parallelism_for(b.len(), self.par);
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
-        Self::ldlt_solve(sym, &self.factor, buffer, par, b);
+        let fast = self.supernodal.as_ref();
+        Self::ldlt_solve(sym, fast, &self.factor, buffer, par, b);
         let parallel = matches!(par, Par::Rayon(_));
         let mut error = backward_error(&self.col_ptr, &self.row_idx, &self.row_values, parallel, self.norm_inf, &self.rhs, b, &mut self.r);
         for _ in 0..2 {
             if !(error > ACCEPT) || !error.is_finite() {
                 break;
             }
-            Self::ldlt_solve(sym, &self.factor, buffer, par, &mut self.r);
+            Self::ldlt_solve(sym, fast, &self.factor, buffer, par, &mut self.r);
             for (x, d) in b.iter_mut().zip(&self.r) {
                 *x += d;
             }
@@ -378,6 +392,7 @@ impl LdltGmres {
     fn preconditioned_solve(&mut self, b: &mut [f64], max_iterations: usize, rtol: f64) -> GmresReport {
         let par = parallelism_for(b.len(), self.par);
         let (sym, buffer) = (self.symbolic.as_ref().unwrap(), self.buffer.as_mut().unwrap());
+        let fast = self.supernodal.as_ref();
         let (col_ptr, row_idx, row_values, factor) = (&self.col_ptr, &self.row_idx, &self.row_values, &self.factor);
         let parallel = matches!(par, Par::Rayon(_));
         // from x = 0: the first iteration finds the best multiple of S^-1 b, as good as starting
@@ -392,7 +407,7 @@ impl LdltGmres {
             max_iterations,
             &mut |x, y| multiply_rows(col_ptr, row_idx, row_values, x, y, parallel),
             &mut |z: &mut [f64]| -> std::result::Result<(), ()> {
-                Self::ldlt_solve(sym, factor, buffer, par, z);
+                Self::ldlt_solve(sym, fast, factor, buffer, par, z);
                 Ok(())
             },
         );
@@ -848,6 +863,27 @@ mod tests {
         let mut s = LdltGmres::new().ordering(Ordering::NestedDissection);
         check_solution(&matrix(3, &[(0, 0, 2.0), (0, 1, 1.0), (1, 1, 3.0), (2, 2, 1.0), (2, 0, 0.5)]), &mut s);
         assert_eq!((s.ordering_used(), s.factor_len()), (None, 0));
+    }
+
+    /// From `PARALLEL_MIN_ROWS` unknowns on, with a supernodal factor, the solves are the
+    /// tree-parallel ones; they give the answers (and the GMRES iterations) of faer's solve,
+    /// which a sequential solver uses.
+    #[test]
+    fn large_matrices_use_the_parallel_supernodal_solve() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        for skew in [0.0, 0.3] {
+            let a = grid(150, skew);
+            assert!(a.nrows() >= crate::linear_solver::PARALLEL_MIN_ROWS);
+            let mut parallel = LdltGmres::with_parallelism(Par::rayon(2));
+            let mut sequential = LdltGmres::with_parallelism(Par::Seq);
+            pool.install(|| check_solution(&a, &mut parallel));
+            check_solution(&a, &mut sequential);
+            assert!(parallel.supernodal.is_some() && sequential.supernodal.is_some());
+            let (p, s) = (parallel.stats(), sequential.stats());
+            assert_eq!((p.direct, p.preconditioned, p.lu_fallbacks), (s.direct, s.preconditioned, 0));
+            assert_eq!(p.gmres_iterations, s.gmres_iterations, "{p:?} {s:?}");
+            assert_eq!(p.direct, usize::from(skew == 0.0));
+        }
     }
 
     #[test]
