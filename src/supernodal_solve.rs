@@ -145,6 +145,27 @@ impl SupernodalSolve {
         self.splits
     }
 
+    /// The work (entries of L) of the whole solve and of its critical path (the most that any
+    /// number of threads must do one after the other): their ratio bounds the parallel speed-up.
+    pub fn work_and_span(&self, symbolic: &SymbolicCholesky<usize>) -> (f64, f64) {
+        fn walk(task: &Task, cost: &dyn Fn(usize) -> f64) -> (f64, f64) {
+            match task {
+                Task::Run { below, nodes, .. } => {
+                    let own: f64 = nodes.iter().map(|&s| cost(s)).sum();
+                    let (w, s) = below.as_ref().map_or((0.0, 0.0), |b| walk(b, cost));
+                    (w + own, s + own)
+                }
+                Task::Split { left, right, .. } => {
+                    let (l, r) = (walk(left, cost), walk(right, cost));
+                    (l.0 + r.0, l.1.max(r.1))
+                }
+            }
+        }
+        let (Some(root), SymbolicCholeskyRaw::Supernodal(sn)) = (&self.root, symbolic.raw()) else { return (0.0, 0.0) };
+        let vp = sn.col_ptr_for_val();
+        walk(root, &|s| (vp[s + 1] - vp[s]) as f64)
+    }
+
     /// Builds the tree, the positions and the tasks; returns the root task and the workspace
     /// length, None if the structure is not the expected one.
     fn schedule(&mut self, sn: &SymbolicSupernodalCholesky<usize>) -> Option<(Task, usize)> {

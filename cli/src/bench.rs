@@ -382,8 +382,12 @@ mod ordering_measurement {
             let mut buffer = MemBuffer::new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()).or(sym.solve_in_place_scratch::<f64>(1, par)));
             let mut factor = vec![0.0; sym.len_val()];
             sym.factorize_numeric_ldlt(&mut factor, a, Side::Lower, Default::default(), par, MemStack::new(&mut buffer), Default::default()).unwrap();
+            let t = Instant::now();
             let ours = SupernodalSolve::new(&sym);
+            let t_schedule = t.elapsed().as_secs_f64();
             assert!(ours.is_parallel());
+            let (work, span) = ours.work_and_span(&sym);
+            println!("n = {n}: schedule built in {t_schedule:.3} s, work / critical path {:.2}", work / span);
             let b: Vec<f64> = (0..neq).map(|i| (i * 7919 % 1000) as f64 / 1000.0 - 0.5).collect();
             let pools: Vec<_> = [1, 2].iter().map(|&t| rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap()).collect();
             // variants: faer 1, faer 2, ours sequential, ours 1 thread, ours 2 threads
