@@ -235,8 +235,8 @@ impl SupernodalSolve {
         }
         let mut position = vec![0u32; n];
         for s in 0..ns {
-            for i in begin[s]..end[s] {
-                position[i] = u32::try_from(offset[s] + i - begin[s]).ok()?;
+            for (rank, p) in position[begin[s]..end[s]].iter_mut().enumerate() {
+                *p = u32::try_from(offset[s] + rank).ok()?;
             }
         }
         // children lists
@@ -860,8 +860,8 @@ mod tests {
                 }
             }
         }
-        for i in 0..n {
-            let d = row_sum[i] + 0.5 + rng.next().abs();
+        for (i, sum) in row_sum.iter().enumerate() {
+            let d = sum + 0.5 + rng.next().abs();
             t.push(Triplet::new(i, i, if indefinite && i % dofs == dofs - 1 { -d } else { d }));
         }
         SparseColMat::try_new_from_triplets(n, n, &t).unwrap()
