@@ -13,7 +13,7 @@
 //! block `factor[col_ptr_for_val[s]..col_ptr_for_val[s + 1]]`, whose top w x w block holds the
 //! unit lower triangle of L below its diagonal and D on its diagonal (what lies above the
 //! diagonal is not read). The fill-reducing permutation is applied around the supernodal solve:
-//! x_perm[i] = b[fwd[i]] before, b[i] = x_perm[inv[i]] after.
+//! `x_perm[i] = b[fwd[i]]` before, `b[i] = x_perm[inv[i]]` after.
 //!
 //! The schedule. The parent of supernode s is the supernode of the first row of its pattern; the
 //! rows of the patterns of a subtree lie in that subtree or in its ancestors (checked when the
@@ -40,7 +40,7 @@
 //! schedule; a solve allocates nothing. The result does not depend on which thread runs what
 //! (the buffers are added in a fixed order), only on the schedule.
 //!
-//! Measured 2026 (the ignored test `solve_pair` in cli/src/bench.rs: the bench tangent's
+//! Measured 2026-11-24 (the ignored test `solve_pair` in cli/src/bench.rs: the bench tangent's
 //! symmetric part, LdltGmres's ordering, one solve pair, the minimum of 10; other benchmarks
 //! shared the 2 cores, the quietest of 4 runs):
 //!
