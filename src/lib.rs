@@ -17,6 +17,7 @@ pub mod element;
 pub mod linear_solver;
 pub mod gmres;
 pub mod ldlt_gmres;
+pub mod supernodal_solve;
 pub mod ordering;
 pub mod bordered;
 pub mod sparse;

@@ -352,6 +352,83 @@ mod ordering_measurement {
         }
     }
 
+    /// One solve pair (forward and backward substitution) with the LDL^T factor of the bench
+    /// tangent's symmetric part (LdltGmres's ordering: nested dissection from
+    /// `ND_MIN_UNKNOWNS` unknowns on), faer's solve against `stamp::supernodal_solve` (its
+    /// sequential path, and its parallel one), with 1 and 2 rayon threads, each the minimum of 10
+    /// runs taking turns (run with
+    /// `STAMP_ORDERING_SIZES=100,200 cargo test --release -p stamp-cli --lib solve_pair -- --ignored --nocapture --test-threads 1`).
+    #[test]
+    #[ignore]
+    fn solve_pair() {
+        use faer::sparse::linalg::cholesky::LdltRef;
+        use faer::{Conj, MatMut, Par};
+        use stamp::supernodal_solve::SupernodalSolve;
+        let sizes = sizes_from_env("STAMP_ORDERING_SIZES", "100,200");
+        println!("n | unknowns | nnz(L) | ordering | splits | faer 1 thread s | faer 2 threads s | ours sequential s | ours 1 thread s | ours 2 threads s | max rel. difference");
+        for n in sizes {
+            let (neq, cp, ri, s) = tangent(n, 0.3);
+            let pattern = SymbolicSparseColMatRef::new_checked(neq, neq, &cp, None, &ri);
+            let a = SparseColMatRef::new(pattern, &s);
+            let nested = neq >= stamp::ldlt_gmres::ND_MIN_UNKNOWNS;
+            let perm = nested.then(|| stamp::ordering::nested_dissection(&cp, &ri).unwrap());
+            let inv = perm.as_ref().map(|p| stamp::ordering::inverse(p));
+            let ord = match (&perm, &inv) {
+                (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, neq)),
+                _ => SymmetricOrdering::Amd,
+            };
+            let sym = factorize_symbolic_cholesky(pattern, Side::Lower, ord, Default::default()).unwrap();
+            let par = Par::rayon(2);
+            let mut buffer = MemBuffer::new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()).or(sym.solve_in_place_scratch::<f64>(1, par)));
+            let mut factor = vec![0.0; sym.len_val()];
+            sym.factorize_numeric_ldlt(&mut factor, a, Side::Lower, Default::default(), par, MemStack::new(&mut buffer), Default::default()).unwrap();
+            let t = Instant::now();
+            let ours = SupernodalSolve::new(&sym);
+            let t_schedule = t.elapsed().as_secs_f64();
+            assert!(ours.is_parallel());
+            let (work, span) = ours.work_and_span(&sym);
+            println!("n = {n}: schedule built in {t_schedule:.3} s, work / critical path {:.2}", work / span);
+            let b: Vec<f64> = (0..neq).map(|i| (i * 7919 % 1000) as f64 / 1000.0 - 0.5).collect();
+            let pools: Vec<_> = [1, 2].iter().map(|&t| rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap()).collect();
+            // variants: faer 1, faer 2, ours sequential, ours 1 thread, ours 2 threads
+            let mut best = [f64::INFINITY; 5];
+            let mut results: Vec<Vec<f64>> = vec![Vec::new(); 5];
+            let mut x = b.clone();
+            for _ in 0..10 {
+                for (v, best) in best.iter_mut().enumerate() {
+                    x.copy_from_slice(&b);
+                    let pool = &pools[if v == 0 || v == 3 { 0 } else { 1 }];
+                    let t = Instant::now();
+                    pool.install(|| match v {
+                        0 | 1 => LdltRef::new(&sym, &factor).solve_in_place_with_conj(
+                            Conj::No,
+                            MatMut::from_column_major_slice_mut(&mut x, neq, 1),
+                            if v == 0 { Par::Seq } else { par },
+                            MemStack::new(&mut buffer),
+                        ),
+                        2 => ours.solve_in_place(&sym, &factor, &mut x, false),
+                        _ => ours.solve_in_place(&sym, &factor, &mut x, true),
+                    });
+                    *best = best.min(t.elapsed().as_secs_f64());
+                    results[v].clone_from(&x);
+                }
+            }
+            let scale = results[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let diff = results[1..].iter().map(|r| r.iter().zip(&results[0]).fold(0.0f64, |m, (a, b)| m.max((a - b).abs())) / scale).fold(0.0, f64::max);
+            println!(
+                "{n} | {neq} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {diff:.1e}",
+                sym.len_val(),
+                if nested { "ND" } else { "AMD" },
+                ours.splits(),
+                best[0],
+                best[1],
+                best[2],
+                best[3],
+                best[4]
+            );
+        }
+    }
+
     /// The whole benchmark solve (as `stamp bench`) under each ordering.
     #[test]
     #[ignore]
