@@ -190,6 +190,8 @@ pub struct LdltGmres {
     /// Seconds of the last numeric factorisation and of one GMRES iteration; GMRES iterations of
     /// the last solve with a fresh factor.
     factor_seconds: f64,
+    /// Whether faer's numeric factorisation runs on the threads or on one (measured per pattern).
+    factor_parallelism: FactorParallelism,
     iteration_seconds: f64,
     fresh_iterations: usize,
     par: Par,
@@ -234,6 +236,7 @@ impl LdltGmres {
             symmetric: false,
             refactor_next: false,
             factor_seconds: 0.0,
+            factor_parallelism: FactorParallelism::default(),
             iteration_seconds: 0.0,
             fresh_iterations: 0,
             par: faer::get_global_parallelism(),
@@ -284,6 +287,13 @@ impl LdltGmres {
         self.symbolic.as_ref().map_or(0, |s| s.len_val())
     }
 
+    /// Whether the numeric factorisations of the current pattern settled on faer's parallel
+    /// setting (true) or on one thread (false), once both were measured; None before (see
+    /// `FactorParallelism`).
+    pub fn factorizes_in_parallel(&self) -> Option<bool> {
+        self.factor_parallelism.settled().map(|p| p != Par::Seq)
+    }
+
     /// What the solver did so far.
     pub fn stats(&self) -> LdltGmresStats {
         self.stats
@@ -325,7 +335,11 @@ impl LdltGmres {
             self.ordering_used = Some(if perm.is_some() { Ordering::NestedDissection } else { Ordering::Amd });
             let scratch = sym.factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default()).or(sym.solve_in_place_scratch::<f64>(1, self.par));
             self.buffer = Some(MemBuffer::try_new(scratch).map_err(|_| StampError::LinearSolver("out of memory for the LDL^T workspace".into()))?);
-            self.factor = vec![0.0; sym.len_val()];
+            // written, not only allocated: the pages are mapped here, not in the first
+            // factorisation, whose time decides the parallelism (FactorParallelism)
+            self.factor.clear();
+            self.factor.resize(sym.len_val(), 0.0);
+            self.factor_parallelism = FactorParallelism::default();
             self.supernodal = Some(SupernodalSolve::new(&sym)).filter(SupernodalSolve::is_parallel);
             self.symbolic = Some(sym);
         }
@@ -357,7 +371,7 @@ impl LdltGmres {
     /// symmetric values; false on a zero pivot or a non-finite factor.
     fn factorize_ldlt(&mut self, values: Option<&[f64]>) -> bool {
         let n = self.col_ptr.len() - 1;
-        let par = parallelism_for(n, self.par);
+        let par = self.factor_parallelism.choose(parallelism_for(n, self.par));
         let (Some(sym), Some(buffer)) = (self.symbolic.as_ref(), self.buffer.as_mut()) else { return false };
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         let s = SparseColMatRef::new(pattern, values.unwrap_or(&self.symmetric_values));
@@ -439,6 +453,9 @@ impl LdltGmres {
         let t = Instant::now();
         let ok = self.factorize_ldlt(values);
         self.factor_seconds = t.elapsed().as_secs_f64();
+        if ok {
+            self.factor_parallelism.record(self.factor_seconds);
+        }
         self.timings.factorization += self.factor_seconds;
         self.timings.factorizations += 1;
         self.refactor_next = false;
@@ -455,6 +472,54 @@ impl LdltGmres {
             self.stats.preconditioned += 1;
         }
         Ok(())
+    }
+}
+
+/// The parallelism of faer's numeric LDL^T, chosen by measurement (issue 5: "faer's parallelism
+/// settings: measure them, do not assume"). With a parallel setting, the first numeric
+/// factorisation of a pattern runs on the threads and the second on one; every later one the way
+/// that was faster. Measured on the 2-core machine with `stamp bench` (2026-11-24): faer's
+/// parallel supernodal factorisation spends its time in scheduling (a third of the samples in
+/// the kernel's sched_yield and task switches), one factorisation 0.95 s on two threads against
+/// 0.65 s on one at n = 200 (240 800 unknowns), 5.2 s either way at n = 400; on a machine with
+/// more cores the threads may win, and then they are kept.
+#[derive(Debug, Clone, Copy, Default)]
+struct FactorParallelism {
+    /// Seconds of the factorisation on the threads and on one, once measured.
+    threads: Option<f64>,
+    one: Option<f64>,
+    /// The setting of the factorisation under way.
+    trying: Option<Par>,
+}
+
+impl FactorParallelism {
+    /// The setting for the next factorisation, given the solver's (`par`).
+    fn choose(&mut self, par: Par) -> Par {
+        let chosen = match (par, self.threads, self.one) {
+            (Par::Seq, _, _) => Par::Seq,
+            (_, None, _) => par,
+            (_, Some(_), None) => Par::Seq,
+            (_, Some(threads), Some(one)) => if one <= threads { Par::Seq } else { par },
+        };
+        self.trying = Some(chosen);
+        chosen
+    }
+
+    /// The seconds of the factorisation made with the last [`FactorParallelism::choose`].
+    fn record(&mut self, seconds: f64) {
+        match self.trying.take() {
+            Some(Par::Seq) if self.threads.is_some() && self.one.is_none() => self.one = Some(seconds),
+            Some(Par::Rayon(_)) if self.threads.is_none() => self.threads = Some(seconds),
+            _ => {}
+        }
+    }
+
+    /// The setting chosen for the factorisations to come, once both were measured.
+    fn settled(&self) -> Option<Par> {
+        match (self.threads, self.one) {
+            (Some(threads), Some(one)) => Some(if one <= threads { Par::Seq } else { Par::rayon(0) }),
+            _ => None,
+        }
     }
 }
 
@@ -978,6 +1043,42 @@ mod tests {
             assert_eq!(p.gmres_iterations, s.gmres_iterations, "{p:?} {s:?}");
             assert_eq!(p.direct, usize::from(skew == 0.0));
         }
+    }
+
+    /// With a parallel setting the first factorisation of a pattern runs on the threads, the
+    /// second on one, the later ones the faster way; a sequential solver never tries the threads;
+    /// a new pattern measures again.
+    #[test]
+    fn the_factorisation_parallelism_is_measured_then_chosen() {
+        let mut f = FactorParallelism::default();
+        assert_eq!(f.choose(Par::rayon(2)), Par::rayon(2));
+        f.record(2.0);
+        assert_eq!((f.choose(Par::rayon(2)), f.settled()), (Par::Seq, None));
+        f.record(1.0);
+        assert_eq!((f.choose(Par::rayon(2)), f.settled()), (Par::Seq, Some(Par::Seq)));
+        f.record(5.0);
+        assert_eq!(f.choose(Par::rayon(2)), Par::Seq, "later timings do not undo the choice");
+        let mut g = FactorParallelism::default();
+        g.choose(Par::rayon(2));
+        g.record(1.0);
+        g.choose(Par::rayon(2));
+        g.record(3.0);
+        assert_eq!((g.choose(Par::rayon(2)), g.settled()), (Par::rayon(2), Some(Par::rayon(0))));
+        let mut h = FactorParallelism::default();
+        assert_eq!(h.choose(Par::Seq), Par::Seq);
+        h.record(1.0);
+        assert_eq!((h.choose(Par::Seq), h.settled()), (Par::Seq, None));
+        // in the solver: two factorisations of a large pattern settle it, a new pattern resets
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let mut s = LdltGmres::with_parallelism(Par::rayon(2));
+        pool.install(|| {
+            check_solution(&grid(150, 0.0), &mut s);
+            assert_eq!(s.factorizes_in_parallel(), None);
+            check_solution(&grid(150, 0.0), &mut s);
+            assert!(s.factorizes_in_parallel().is_some());
+            check_solution(&grid(151, 0.0), &mut s);
+            assert_eq!(s.factorizes_in_parallel(), None);
+        });
     }
 
     #[test]

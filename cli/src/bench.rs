@@ -57,6 +57,9 @@ pub struct BenchRun {
     pub assemblies: usize,
     pub factorizations: usize,
     pub threads: usize,
+    /// Threads of the numeric factorisations: the solver measures faer's parallel setting
+    /// against one thread on the first two and keeps the faster (`LdltGmres`).
+    pub factorization_threads: usize,
     /// What the linear solver did: LDL^T factorisations used directly or as GMRES preconditioner,
     /// GMRES iterations, hand-overs to the LU.
     pub linear_solver: LdltGmresStats,
@@ -175,6 +178,7 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
         assemblies: mt.assemblies,
         factorizations: st.factorizations,
         threads: rayon::current_num_threads(),
+        factorization_threads: if newton.linear.factorizes_in_parallel() == Some(true) { rayon::current_num_threads() } else { 1 },
         linear_solver: newton.linear.stats(),
         centre_deflection: 0.5 * (u[2] + u[5]),
         reaction,
@@ -206,8 +210,8 @@ pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut
 pub fn header() -> String {
     format!(
         "stamp bench: simply supported square plate (side {SIDE}, h = {THICKNESS}, quarter model) under a sphere (R = {RADIUS}, travel {PUNCH_TRAVEL})\n\
-         {:>5} {:>9} {:>5} {:>6} {:>7} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
-        "n", "unknowns", "steps", "newton", "factors", "gmres", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
+         {:>5} {:>9} {:>5} {:>6} {:>7} {:>4} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
+        "n", "unknowns", "steps", "newton", "factors", "fthr", "gmres", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
     )
 }
 
@@ -215,12 +219,13 @@ pub fn header() -> String {
 pub fn row(r: &BenchRun) -> String {
     let s = &r.seconds;
     format!(
-        "{:>5} {:>9} {:>5} {:>6} {:>7} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
+        "{:>5} {:>9} {:>5} {:>6} {:>7} {:>4} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
         r.n,
         r.unknowns,
         r.steps,
         r.newton_iterations,
         r.factorizations,
+        r.factorization_threads,
         r.linear_solver.gmres_iterations,
         s.assembly,
         s.contact,
@@ -244,7 +249,7 @@ pub fn bench_command(sizes: &[usize], json: bool, options: SolverOptions) -> Res
     } else {
         println!("{}", header());
         run_sizes(sizes, options, |r| println!("{}", row(r)))?;
-        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), gmres: GMRES iterations", rayon::current_num_threads());
+        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), fthr: their threads (the first two measure faer's parallel setting against one thread; the faster is kept), gmres: GMRES iterations", rayon::current_num_threads());
     }
     Ok(())
 }
