@@ -373,11 +373,7 @@ impl LdltGmres {
         let n = self.col_ptr.len() - 1;
         let par = self.factor_parallelism.choose(parallelism_for(n, self.par));
         let (Some(sym), Some(buffer)) = (self.symbolic.as_ref(), self.buffer.as_mut()) else { return false };
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-        let s = SparseColMatRef::new(pattern, values.unwrap_or(&self.symmetric_values));
-        let ok = sym.factorize_numeric_ldlt(&mut self.factor, s, Side::Lower, LdltRegularization::default(), par, MemStack::new(buffer), Default::default()).is_ok();
-        crate::vector_state::clean_upper_vector_state();
-        ok && pivots(sym, &self.factor).all(|d| d.is_finite() && d != 0.0)
+        factorize_numeric(sym, buffer, &mut self.factor, &self.col_ptr, &self.row_idx, values.unwrap_or(&self.symmetric_values), par)
     }
 
     /// x = S^-1 x with the LDL^T factor: by the tree-parallel solve `supernodal` when given (on
@@ -452,7 +448,13 @@ impl LdltGmres {
     fn fresh_factorization(&mut self, values: Option<&[f64]>) -> Result<()> {
         let t = Instant::now();
         let ok = self.factorize_ldlt(values);
-        self.factor_seconds = t.elapsed().as_secs_f64();
+        self.factorized(ok, t.elapsed().as_secs_f64())
+    }
+
+    /// The bookkeeping after a numeric LDL^T that took `seconds` and succeeded if `ok` (the LU
+    /// otherwise).
+    fn factorized(&mut self, ok: bool, seconds: f64) -> Result<()> {
+        self.factor_seconds = seconds;
         if ok {
             self.factor_parallelism.record(self.factor_seconds);
         }
@@ -493,14 +495,19 @@ struct FactorParallelism {
 }
 
 impl FactorParallelism {
-    /// The setting for the next factorisation, given the solver's (`par`).
-    fn choose(&mut self, par: Par) -> Par {
-        let chosen = match (par, self.threads, self.one) {
+    /// The setting for the next factorisation, given the solver's (`par`), without choosing it.
+    fn next(&self, par: Par) -> Par {
+        match (par, self.threads, self.one) {
             (Par::Seq, _, _) => Par::Seq,
             (_, None, _) => par,
             (_, Some(_), None) => Par::Seq,
             (_, Some(threads), Some(one)) => if one <= threads { Par::Seq } else { par },
-        };
+        }
+    }
+
+    /// The setting for the next factorisation, given the solver's (`par`).
+    fn choose(&mut self, par: Par) -> Par {
+        let chosen = self.next(par);
         self.trying = Some(chosen);
         chosen
     }
@@ -521,6 +528,17 @@ impl FactorParallelism {
             _ => None,
         }
     }
+}
+
+/// The numeric LDL^T of the matrix with `values` in the pattern (`col_ptr`, `row_idx`; the lower
+/// triangle is read) into `factor`; false on a failure, a zero or a non-finite pivot.
+fn factorize_numeric(sym: &SymbolicCholesky<usize>, buffer: &mut MemBuffer, factor: &mut [f64], col_ptr: &[usize], row_idx: &[usize], values: &[f64], par: Par) -> bool {
+    let n = col_ptr.len() - 1;
+    let pattern = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
+    let s = SparseColMatRef::new(pattern, values);
+    let ok = sym.factorize_numeric_ldlt(factor, s, Side::Lower, LdltRegularization::default(), par, MemStack::new(buffer), Default::default()).is_ok();
+    crate::vector_state::clean_upper_vector_state();
+    ok && pivots(sym, factor).all(|d| d.is_finite() && d != 0.0)
 }
 
 /// The pivots D of an LDL^T factor, in the factor's (permuted) order: faer keeps them on L's
@@ -696,6 +714,36 @@ impl LinearSolver for LdltGmres {
         // one pass over A: A by rows, its row sums, its asymmetry and size, and its symmetric
         // part unless a P will be factorised instead
         let parallel = parallelism_for(a.nrows(), self.par) != Par::Seq;
+        // A given P factorised on one thread (FactorParallelism) leaves the other threads idle:
+        // one of them takes A apart meanwhile (at n = 400 in `stamp bench` a pass of about 0.1 s
+        // per factorisation, hidden). Should A turn out symmetric, A itself is factorised after.
+        let fresh = !(self.reuse && self.factor_valid && !self.refactor_next);
+        if let (Some(p), true, false, true) = (given, parallel, self.reuse, fresh) {
+            let par = parallelism_for(a.nrows(), self.par);
+            if self.factor_parallelism.next(par) == Par::Seq {
+                self.factor_parallelism.choose(par);
+                let (Some(sym), Some(buffer)) = (self.symbolic.as_ref(), self.buffer.as_mut()) else {
+                    return Err(StampError::LinearSolver("no symbolic LDL^T for a symmetric pattern".into()));
+                };
+                let (col_ptr, row_idx, factor, row_values, r) = (&self.col_ptr, &self.row_idx, &mut self.factor, &mut self.row_values, &mut self.r);
+                let t = Instant::now();
+                let (ok, (worst, size)) = rayon::join(
+                    || factorize_numeric(sym, buffer, factor, col_ptr, row_idx, p.val(), Par::Seq),
+                    || split_values(col_ptr, tr, a.val(), row_values, None, r, false),
+                );
+                let seconds = t.elapsed().as_secs_f64();
+                self.norm_inf = self.r.iter().fold(0.0f64, |m, x| m.max(*x));
+                self.symmetric = worst <= SYMMETRY_TOL * size;
+                if self.symmetric {
+                    // not the matrix to factorise after all (its time is not a measurement)
+                    self.fresh_factorization(Some(a.val()))?;
+                } else {
+                    self.factorized(ok, seconds)?;
+                }
+                self.factored = true;
+                return Ok(());
+            }
+        }
         if given.is_none() || self.reuse {
             self.symmetric_values.resize(self.row_idx.len(), 0.0);
         }
@@ -1079,6 +1127,40 @@ mod tests {
             check_solution(&grid(151, 0.0), &mut s);
             assert_eq!(s.factorizes_in_parallel(), None);
         });
+    }
+
+    /// A given P factorised on one thread while another takes A apart (the second factorisation
+    /// of a pattern always runs on one thread) solves as the plain path does; a symmetric A with
+    /// a P is factorised itself (direct), whichever path it takes.
+    #[test]
+    fn a_preconditioner_factorised_beside_the_pass_over_a_solves_the_same() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        for skew in [0.3, 0.0] {
+            let a = grid(150, skew);
+            assert!(a.nrows() >= crate::linear_solver::PARALLEL_MIN_ROWS);
+            let p = grid(150, 0.0);
+            let n = a.nrows();
+            let exact: Vec<f64> = (0..n).map(|i| (0.3 * i as f64).cos() + 0.1 * i as f64).collect();
+            let mut s = LdltGmres::with_parallelism(Par::rayon(2));
+            for round in 0..3 {
+                // another A each round (a stale pass over A would show)
+                let mut a = a.clone();
+                a.val_mut().iter_mut().for_each(|v| *v *= 1.0 + 0.5 * round as f64);
+                let mut x = vec![0.0; n];
+                multiply(a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val(), &exact, &mut x);
+                pool.install(|| {
+                    s.factorize_preconditioned(a.as_ref(), Some(p.as_ref())).unwrap();
+                    s.solve_in_place(&mut x).unwrap();
+                });
+                let scale = exact.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let err = x.iter().zip(&exact).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale;
+                assert!(err < 1e-9, "skew {skew}, round {round}: error {err:e}, {:?}", s.stats());
+            }
+            let st = s.stats();
+            let expected = if skew == 0.0 { (3, 0) } else { (0, 3) };
+            assert_eq!((st.direct, st.preconditioned, st.lu_fallbacks), (expected.0, expected.1, 0), "skew {skew}");
+            assert!(s.factorizes_in_parallel().is_some());
+        }
     }
 
     #[test]
