@@ -36,8 +36,9 @@ pub struct Model<E: Element> {
     /// [`ContactPair::constraint_violation`]); `None` for the plain perturbed Lagrangian.
     pub augmented_tolerance: Option<f64>,
     pattern: SparsePattern,
-    /// The nodal pattern (without the force-driven punches' border).
-    nodal_pattern: SparsePattern,
+    /// The nodal pattern (without the force-driven punches' border) while `pattern` is bordered;
+    /// None while `pattern` is the nodal one (no copy of a pattern that can be 0.4 GB).
+    nodal_pattern: Option<SparsePattern>,
     /// Per force-driven punch: (index in `contacts`, number of candidate points) the pattern was
     /// bordered for.
     border: Vec<(usize, usize)>,
@@ -83,7 +84,7 @@ impl<E: Element> Model<E> {
             loads: Vec::new(),
             contacts: Vec::new(),
             augmented_tolerance: None,
-            nodal_pattern: pattern.clone(),
+            nodal_pattern: None,
             pattern,
             border: Vec::new(),
             assembler,
@@ -140,10 +141,13 @@ impl<E: Element> Model<E> {
             return;
         }
         if sig.is_empty() {
-            self.pattern = self.nodal_pattern.clone();
+            if let Some(nodal) = self.nodal_pattern.take() {
+                self.pattern = nodal;
+            }
         } else {
             let border: Vec<Vec<usize>> = sig.iter().map(|&(i, _)| self.contacts[i].points.iter().flat_map(|p| p.dofs).collect()).collect();
-            self.pattern = self.nodal_pattern.bordered(&self.dofs, &border);
+            let nodal = self.nodal_pattern.get_or_insert_with(|| self.pattern.clone());
+            self.pattern = nodal.bordered(&self.dofs, &border);
         }
         self.border = sig;
         let nb = self.border.len();
