@@ -444,6 +444,13 @@ impl LdltGmres {
 
 impl LdltGmres {
     /// The LDL^T of the current matrix's symmetric part (or the LU where that fails).
+    /// After the pass over A ([`split_values`], row sums in `r`): its infinity norm, and whether
+    /// it is symmetric (largest asymmetry `worst`, largest entry `size`).
+    fn passed_over(&mut self, worst: f64, size: f64) {
+        self.norm_inf = self.r.iter().fold(0.0f64, |m, x| m.max(*x));
+        self.symmetric = worst <= SYMMETRY_TOL * size;
+    }
+
     /// `values` as in [`LdltGmres::factorize_ldlt`].
     fn fresh_factorization(&mut self, values: Option<&[f64]>) -> Result<()> {
         let t = Instant::now();
@@ -711,15 +718,13 @@ impl LinearSolver for LdltGmres {
             }
             _ => None,
         };
-        // one pass over A: A by rows, its row sums, its asymmetry and size, and its symmetric
-        // part unless a P will be factorised instead
-        let parallel = parallelism_for(a.nrows(), self.par) != Par::Seq;
+        let par = parallelism_for(a.nrows(), self.par);
+        let parallel = par != Par::Seq;
         // A given P factorised on one thread (FactorParallelism) leaves the other threads idle:
-        // one of them takes A apart meanwhile (at n = 400 in `stamp bench` a pass of about 0.1 s
-        // per factorisation, hidden). Should A turn out symmetric, A itself is factorised after.
-        let fresh = !(self.reuse && self.factor_valid && !self.refactor_next);
-        if let (Some(p), true, false, true) = (given, parallel, self.reuse, fresh) {
-            let par = parallelism_for(a.nrows(), self.par);
+        // one of them takes A apart meanwhile (the pass below; at n = 400 in `stamp bench` about
+        // 0.1 s per factorisation, hidden). Should A turn out symmetric, A itself is factorised
+        // after. (Without reuse every factorisation is fresh.)
+        if let (Some(p), true, false) = (given, parallel, self.reuse) {
             if self.factor_parallelism.next(par) == Par::Seq {
                 self.factor_parallelism.choose(par);
                 let (Some(sym), Some(buffer)) = (self.symbolic.as_ref(), self.buffer.as_mut()) else {
@@ -732,8 +737,7 @@ impl LinearSolver for LdltGmres {
                     || split_values(col_ptr, tr, a.val(), row_values, None, r, false),
                 );
                 let seconds = t.elapsed().as_secs_f64();
-                self.norm_inf = self.r.iter().fold(0.0f64, |m, x| m.max(*x));
-                self.symmetric = worst <= SYMMETRY_TOL * size;
+                self.passed_over(worst, size);
                 if self.symmetric {
                     // not the matrix to factorise after all (its time is not a measurement)
                     self.fresh_factorization(Some(a.val()))?;
@@ -744,13 +748,14 @@ impl LinearSolver for LdltGmres {
                 return Ok(());
             }
         }
+        // one pass over A: A by rows, its row sums, its asymmetry and size, and its symmetric
+        // part unless a P will be factorised instead
         if given.is_none() || self.reuse {
             self.symmetric_values.resize(self.row_idx.len(), 0.0);
         }
         let sym = if given.is_some() { None } else { Some(self.symmetric_values.as_mut_slice()) };
         let (worst, size) = split_values(&self.col_ptr, tr, a.val(), &mut self.row_values, sym, &mut self.r, parallel);
-        self.norm_inf = self.r.iter().fold(0.0f64, |m, x| m.max(*x));
-        self.symmetric = worst <= SYMMETRY_TOL * size;
+        self.passed_over(worst, size);
         // the values to factorise: a symmetric A itself, else the given P, else the symmetric part
         // just written; kept when a factor may have to be renewed later (reuse), else read where
         // they lie (no copy: 0.4 GB at n = 400 in `stamp bench`)
