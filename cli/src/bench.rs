@@ -293,6 +293,21 @@ mod ordering_measurement {
         (a.ncols(), cp, ri, s)
     }
 
+    /// The symbolic LDL^T of the pattern (`cp`, `ri`) ordered by nested dissection (METIS) if
+    /// `nested`, else by faer's AMD, and the seconds METIS took.
+    fn ordered_symbolic(neq: usize, cp: &[usize], ri: &[usize], nested: bool) -> (faer::sparse::linalg::cholesky::SymbolicCholesky<usize>, f64) {
+        let t0 = Instant::now();
+        let perm = nested.then(|| stamp::ordering::nested_dissection(cp, ri).unwrap());
+        let t_order = t0.elapsed().as_secs_f64();
+        let inv = perm.as_ref().map(|p| stamp::ordering::inverse(p));
+        let ord = match (&perm, &inv) {
+            (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, neq)),
+            _ => SymmetricOrdering::Amd,
+        };
+        let pattern = SymbolicSparseColMatRef::new_checked(neq, neq, cp, None, ri);
+        (factorize_symbolic_cholesky(pattern, Side::Lower, ord, Default::default()).unwrap(), t_order)
+    }
+
     /// Multiply-adds of the LDL^T: sum over the columns of L of (entries below the diagonal)^2.
     fn flops(sym: &faer::sparse::linalg::cholesky::SymbolicCholesky<usize>) -> f64 {
         use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
@@ -325,14 +340,7 @@ mod ordering_measurement {
             let mut runs = Vec::new();
             for name in ["AMD", "ND"] {
                 let t0 = Instant::now();
-                let perm = (name == "ND").then(|| stamp::ordering::nested_dissection(&cp, &ri).unwrap());
-                let t_order = t0.elapsed().as_secs_f64();
-                let inv = perm.as_ref().map(|p| stamp::ordering::inverse(p));
-                let ord = match (&perm, &inv) {
-                    (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, neq)),
-                    _ => SymmetricOrdering::Amd,
-                };
-                let sym = factorize_symbolic_cholesky(pattern, Side::Lower, ord, Default::default()).unwrap();
+                let (sym, t_order) = ordered_symbolic(neq, &cp, &ri, name == "ND");
                 let t_sym = t0.elapsed().as_secs_f64();
                 runs.push((name, sym, t_order, t_sym, f64::INFINITY));
             }
@@ -376,13 +384,7 @@ mod ordering_measurement {
             let pattern = SymbolicSparseColMatRef::new_checked(neq, neq, &cp, None, &ri);
             let a = SparseColMatRef::new(pattern, &s);
             let nested = neq >= stamp::ldlt_gmres::ND_MIN_UNKNOWNS;
-            let perm = nested.then(|| stamp::ordering::nested_dissection(&cp, &ri).unwrap());
-            let inv = perm.as_ref().map(|p| stamp::ordering::inverse(p));
-            let ord = match (&perm, &inv) {
-                (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, neq)),
-                _ => SymmetricOrdering::Amd,
-            };
-            let sym = factorize_symbolic_cholesky(pattern, Side::Lower, ord, Default::default()).unwrap();
+            let (sym, _) = ordered_symbolic(neq, &cp, &ri, nested);
             let par = Par::rayon(2);
             let mut buffer = MemBuffer::new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()).or(sym.solve_in_place_scratch::<f64>(1, par)));
             let mut factor = vec![0.0; sym.len_val()];
