@@ -291,7 +291,7 @@ impl LdltGmres {
     /// setting (true) or on one thread (false), once both were measured; None before (see
     /// `FactorParallelism`).
     pub fn factorizes_in_parallel(&self) -> Option<bool> {
-        self.factor_parallelism.settled().map(|p| p != Par::Seq)
+        self.factor_parallelism.threads_won()
     }
 
     /// What the solver did so far.
@@ -504,11 +504,9 @@ struct FactorParallelism {
 impl FactorParallelism {
     /// The setting for the next factorisation, given the solver's (`par`), without choosing it.
     fn next(&self, par: Par) -> Par {
-        match (par, self.threads, self.one) {
-            (Par::Seq, _, _) => Par::Seq,
-            (_, None, _) => par,
-            (_, Some(_), None) => Par::Seq,
-            (_, Some(threads), Some(one)) => if one <= threads { Par::Seq } else { par },
+        match (par, self.threads, self.threads_won()) {
+            (Par::Seq, _, _) | (_, Some(_), None | Some(false)) => Par::Seq,
+            _ => par,
         }
     }
 
@@ -528,12 +526,10 @@ impl FactorParallelism {
         }
     }
 
-    /// The setting chosen for the factorisations to come, once both were measured.
-    fn settled(&self) -> Option<Par> {
-        match (self.threads, self.one) {
-            (Some(threads), Some(one)) => Some(if one <= threads { Par::Seq } else { Par::rayon(0) }),
-            _ => None,
-        }
+    /// Whether the threads were faster than one thread, once both were measured (a tie goes to
+    /// one thread).
+    fn threads_won(&self) -> Option<bool> {
+        Some(self.threads? < self.one?)
     }
 }
 
@@ -1106,9 +1102,9 @@ mod tests {
         let mut f = FactorParallelism::default();
         assert_eq!(f.choose(Par::rayon(2)), Par::rayon(2));
         f.record(2.0);
-        assert_eq!((f.choose(Par::rayon(2)), f.settled()), (Par::Seq, None));
+        assert_eq!((f.choose(Par::rayon(2)), f.threads_won()), (Par::Seq, None));
         f.record(1.0);
-        assert_eq!((f.choose(Par::rayon(2)), f.settled()), (Par::Seq, Some(Par::Seq)));
+        assert_eq!((f.choose(Par::rayon(2)), f.threads_won()), (Par::Seq, Some(false)));
         f.record(5.0);
         assert_eq!(f.choose(Par::rayon(2)), Par::Seq, "later timings do not undo the choice");
         let mut g = FactorParallelism::default();
@@ -1116,11 +1112,11 @@ mod tests {
         g.record(1.0);
         g.choose(Par::rayon(2));
         g.record(3.0);
-        assert_eq!((g.choose(Par::rayon(2)), g.settled()), (Par::rayon(2), Some(Par::rayon(0))));
+        assert_eq!((g.choose(Par::rayon(2)), g.threads_won()), (Par::rayon(2), Some(true)));
         let mut h = FactorParallelism::default();
         assert_eq!(h.choose(Par::Seq), Par::Seq);
         h.record(1.0);
-        assert_eq!((h.choose(Par::Seq), h.settled()), (Par::Seq, None));
+        assert_eq!((h.choose(Par::Seq), h.threads_won()), (Par::Seq, None));
         // in the solver: two factorisations of a large pattern settle it, a new pattern resets
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         let mut s = LdltGmres::with_parallelism(Par::rayon(2));
