@@ -309,8 +309,9 @@ impl LdltGmres {
             Ordering::Auto => n >= ND_MIN_UNKNOWNS,
         };
         // METIS runs on one thread: the copies of the pattern and its transpose positions are
-        // made beside it (at n = 200 in `stamp bench` 0.12 s of the 0.35 s ordering); the
-        // ordering of a pattern that turns out not symmetric is dropped (METIS fails: AMD).
+        // made beside it (at n = 200 in `stamp bench` 0.12 s of the 0.35 s ordering). A pattern
+        // that turns out not symmetric has no LDL^T: its ordering goes unused (the LU orders its
+        // own); a METIS failure leaves AMD.
         let (col_ptr, row_idx) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
         let (perm, (transpose, (col_ptr, row_idx))) = rayon::join(
             || if nested { ordering::nested_dissection(col_ptr, row_idx).ok() } else { None },
