@@ -364,7 +364,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                 let e = p.evaluate(&trial, t, false);
                 if debug {
                     match &e {
-                        Ok(e) => eprintln!("  line search alpha={alpha} |R|={:.3e}", e.residual_norm),
+                        Ok(e) => eprintln!("  line search alpha={alpha} |R|={:.3e} changes={}", e.residual_norm, e.active_changes),
                         Err(err) => eprintln!("  line search alpha={alpha} refused: {err}"),
                     }
                 }
