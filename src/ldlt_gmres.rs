@@ -673,21 +673,21 @@ fn backward_error(col_ptr: &[usize], row_idx: &[usize], row_values: &[f64], para
     if denominator == 0.0 { 0.0 } else { inf(r) / denominator }
 }
 
-/// For every stored (i, j), the position of (j, i); None if the pattern is not symmetric. Row
-/// indices must be sorted within each column (faer's invariant).
-/// Write every page of `v` (zeros), in parallel, so that its memory is mapped now.
+/// Map the memory of a zero-filled `v` now, by all threads: one write of zero per 4 KiB page
+/// (512 values), volatile since the allocation is zero already and a plain write of zero could
+/// be elided. The values stay zero.
 fn touch_pages(v: &mut [f64]) {
     use rayon::prelude::*;
-    // a page of f64s per write
     v.par_chunks_mut(1 << 16).for_each(|chunk| {
         for page in chunk.chunks_mut(512) {
-            // volatile: the allocation is zero already, so a plain write of zero could be elided
             // SAFETY: `page` is a non-empty slice (chunks_mut never yields an empty one)
             unsafe { std::ptr::write_volatile(page.as_mut_ptr(), 0.0) };
         }
     });
 }
 
+/// For every stored (i, j), the position of (j, i); None if the pattern is not symmetric. Row
+/// indices must be sorted within each column (faer's invariant).
 fn transpose_positions(col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize>> {
     let mut out = vec![0usize; row_idx.len()];
     crate::sparse::pair_transposed(col_ptr, row_idx, |k, partner| out[k] = partner).then_some(out)
@@ -1067,6 +1067,17 @@ mod tests {
             }
         }
         matrix(k * k, &e)
+    }
+
+    /// Touching the pages of a zero vector keeps it zero, at every length (chunks and pages cut
+    /// anywhere, the empty vector included).
+    #[test]
+    fn touched_pages_stay_zero() {
+        for len in [0, 1, 511, 512, 513, (1 << 16) + 7, 3 << 16] {
+            let mut v = vec![0.0; len];
+            touch_pages(&mut v);
+            assert!(v.len() == len && v.iter().all(|&x| x == 0.0), "{len}");
+        }
     }
 
     #[test]
