@@ -60,3 +60,41 @@ impl StampError {
         StampError::Io { path: path.as_ref().display().to_string(), source }
     }
 }
+
+/// Longest piece of user text (a name, a value, a line of a file) that a message quotes.
+pub const QUOTE_LIMIT: usize = 80;
+
+/// User text made fit to quote in a message: control characters and bytes that are not printable
+/// text become `?`, and anything past [`QUOTE_LIMIT`] characters is cut with "... (N characters)",
+/// so that a message never echoes binary bytes or an unbounded string.
+pub fn quote(text: &str) -> String {
+    let total = text.chars().count();
+    let mut out: String =
+        text.chars().take(QUOTE_LIMIT).map(|c| if c.is_control() || c == '\u{fffd}' { '?' } else { c }).collect();
+    if total > QUOTE_LIMIT {
+        out.push_str(&format!("... ({total} characters)"));
+    }
+    out
+}
+
+/// [`quote`] for raw bytes (read from a file that may be binary).
+pub fn quote_bytes(bytes: &[u8]) -> String {
+    quote(&String::from_utf8_lossy(&bytes[..bytes.len().min(4 * QUOTE_LIMIT)]))
+        + if bytes.len() > 4 * QUOTE_LIMIT { "..." } else { "" }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quote_cuts_long_text_and_hides_control_bytes() {
+        assert_eq!(quote("abc"), "abc");
+        assert_eq!(quote("a\u{0}b\nc"), "a?b?c");
+        let long = "x".repeat(100_000);
+        let q = quote(&long);
+        assert!(q.len() < 120, "{q}");
+        assert!(q.ends_with("(100000 characters)"), "{q}");
+        assert_eq!(quote_bytes(&[b'a', 0xff, 0x00, b'b']), "a??b");
+    }
+}

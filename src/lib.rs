@@ -11,7 +11,7 @@ pub mod io;
 pub mod mesh;
 pub mod surface;
 
-pub use error::{Result, StampError};
+pub use error::{quote, Result, StampError};
 pub mod dofs;
 pub mod element;
 pub mod linear_solver;
