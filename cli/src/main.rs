@@ -33,6 +33,13 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Read and build a problem file, say what is wrong with it (rigid motions held by nothing,
+    /// a punch starting inside the plate, empty groups; warnings for punches that move away or sit
+    /// on the other side) and print a summary of the model, without solving.
+    Check {
+        /// The problem file (see meshes/*.toml).
+        problem: PathBuf,
+    },
     /// Time the solve of the simply supported plate under a sphere (quarter model) on n x n meshes.
     Bench {
         /// Mesh sizes n (n x n elements on the quarter), comma separated.
@@ -62,6 +69,7 @@ fn main() -> ExitCode {
         None => stamp_cli::report::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::report::paper_command(json, plot.as_deref()),
         Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
+        Some(Command::Check { problem }) => stamp_cli::run::check_command(&problem),
         Some(Command::Bench { one: Some(n), reuse, symmetric_part, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part }),
         Some(Command::Bench { sizes, json, reuse, symmetric_part, one: None }) => {
             stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part })

@@ -3,15 +3,22 @@
 //! * [`problem`]: the TOML schema (serde, `deny_unknown_fields`) and its checks;
 //! * [`mesh`]: the gmsh mesh or the built-in rectangle, with groups by dimension;
 //! * [`build`]: section, plate elements, constraints, loads, punches, solver settings;
+//! * [`check`]: what is wrong with a built problem, said before the solve (`stamp check`), with
+//!   [`rigid_modes`] (rigid motions held by nothing) and [`punch_start`] (gaps at the start);
+//! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those);
 //! * [`solve`]: Newton-Raphson along the targets with a progress bar, writing every step;
 //! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step;
 //! * [`plot`]: PNG/SVG line plots (contact pressure, the paper's Figure 4).
 
 pub mod build;
+pub mod check;
 pub mod mesh;
+pub mod out_dir;
 pub mod output;
 pub mod plot;
 pub mod problem;
+pub mod punch_start;
+pub mod rigid_modes;
 pub mod solve;
 
 pub use problem::Problem;
@@ -24,14 +31,42 @@ use stamp::StampError;
 use stamp_elements::Kinematics;
 use std::path::Path;
 
-/// Read, build, solve and write the problem file `problem` into `out` (default
-/// `<problem dir>/<problem stem>-out`). On a Newton failure the converged steps are written and the
-/// error is returned.
+/// Read, build, check, solve and write the problem file `problem` into `out` (default
+/// `<problem dir>/<problem stem>-out`). The checks of [`check::check`] come first: an error stops
+/// the run before anything is written, warnings go to stderr (also with `quiet`), and so does,
+/// after the run, a warning for every punch that never touched the plate. On a Newton failure the
+/// converged steps are written and the error is returned.
 pub fn run(problem: &Path, out: Option<&Path>, quiet: bool) -> stamp::Result<RunOutcome> {
     let p = Problem::read(problem)?;
     let setup = build::build(&p)?;
+    let report = check::check(&p, &setup)?;
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
-    solve::solve_and_write(&p, setup, &out_dir, quiet)
+    let outcome = solve::solve_and_write(&p, setup, &out_dir, quiet);
+    for w in check::never_touched(&p, &out_dir.join("summary.json")) {
+        eprintln!("warning: {w}");
+    }
+    outcome
+}
+
+/// `stamp check`: read and build the problem file, run the checks, print the model's summary on
+/// stdout and the warnings on stderr; an error is returned as it is.
+pub fn check_command(problem: &Path) -> stamp::Result<()> {
+    let p = Problem::read(problem)?;
+    let setup = build::build(&p)?;
+    let report = check::check(&p, &setup)?;
+    println!("{}", report.summary);
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    println!("check: no errors{}", match report.warnings.len() {
+        0 => String::new(),
+        1 => ", 1 warning".into(),
+        n => format!(", {n} warnings"),
+    });
+    Ok(())
 }
 
 /// Run the problem file `problem`, writing into `out`.

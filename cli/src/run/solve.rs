@@ -132,6 +132,8 @@ pub fn default_out_dir(problem: &Path) -> PathBuf {
 pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -> Result<RunOutcome> {
     let start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
+    // removes the previous run's files; records this run's when dropped (see out_dir.rs)
+    let _folder = super::out_dir::RunFolder::claim(out_dir)?;
     let Setup { mesh, mut model, section, punches, targets, settings } = setup;
     let out = &p.spec.output;
     let stem = p.path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "step".into());

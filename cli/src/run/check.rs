@@ -1,0 +1,508 @@
+//! `stamp check`: what is wrong with a built problem, said before any solve, and a short summary
+//! of the model. `stamp run` runs the same checks first.
+//!
+//! Errors (no solve):
+//! * a support, load or punch on a group with nothing in it (no nodes; a line load on a curve with
+//!   no edges; a pressure or surface load on a surface with no cells);
+//! * a punch that starts inside the plate by more than its penetration tolerance
+//!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness);
+//! * rigid-body motions held by nothing (see [`super::rigid_modes`]): the rows are the supports'
+//!   held components (fixed and prescribed dofs, plane strain) at their faces, and the normals of a
+//!   punch at the points where it touches the plate at the start (gap <= [`TOUCH`] times the model
+//!   size, or the penetration tolerance), or, for a force-driven punch that touches nothing yet,
+//!   at the points closest to it (its travel is an unknown: it comes down onto them).
+//!
+//! Warnings (the solve goes on): a punch whose motion or force moves it away from its contact face;
+//! a punch on the side of the plate away from its contact face; after a run, a punch that never
+//! touched the plate ([`never_touched`]).
+
+use super::build::Setup;
+use super::mesh::MeshData;
+use super::problem::{LoadFace, LoadKind, Problem};
+use super::punch_start::{first_gap, gap_at, start_gaps, PointGap};
+use super::rigid_modes::{num, RigidModes};
+use nalgebra::Vector3;
+use stamp::dofs::PRESCRIBED;
+use stamp::nonlinear::NonlinearProblem;
+use stamp::{quote, Result, StampError};
+use stamp_elements::Face;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Default penetration tolerance at the start, as a fraction of the plate thickness.
+pub const DEFAULT_PENETRATION: f64 = 1e-3;
+/// A punch touches the plate at the start where the gap is below this fraction of the model size.
+pub const TOUCH: f64 = 1e-6;
+
+/// Where every punch starts.
+#[derive(Debug, Clone)]
+pub struct PunchStart {
+    pub key: String,
+    pub name: String,
+    /// The candidate point closest to the punch.
+    pub first: Option<PointGap>,
+    /// Points that hold rigid motions at the start (touching, or closest for a force-driven punch).
+    pub holding: Vec<PointGap>,
+    /// The holding points touch the plate (not merely closest to a force-driven punch).
+    pub touching: bool,
+}
+
+/// What the checks found: the summary of the model and the warnings.
+#[derive(Debug, Clone)]
+pub struct CheckReport {
+    pub summary: String,
+    pub warnings: Vec<String>,
+    pub punches: Vec<PunchStart>,
+}
+
+/// Run every check on a built problem: Err with the first error, else the summary and warnings.
+pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
+    check_groups(p, &setup.mesh)?;
+    let size = model_size(setup);
+    let mut starts = Vec::new();
+    for i in 0..setup.punches.len() {
+        starts.push(punch_start(p, setup, i, size)?);
+    }
+    let rigid = check_rigid_modes(p, setup, &starts, size)?;
+    let warnings = punch_warnings(p, setup, &starts);
+    let summary = summary(p, setup, &starts, &rigid);
+    Ok(CheckReport { summary, warnings, punches: starts })
+}
+
+fn file(p: &Problem) -> String {
+    p.path.display().to_string()
+}
+
+/// Half the diagonal of the plate's bounding box, at least the thickness.
+fn model_size(setup: &Setup) -> f64 {
+    let (lo, hi) = bbox(&setup.mesh);
+    (0.5 * ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).sqrt()).max(setup.section.thickness())
+}
+
+fn bbox(mesh: &MeshData) -> ([f64; 2], [f64; 2]) {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for c in &mesh.mesh.coords {
+        for i in 0..2 {
+            lo[i] = lo[i].min(c[i]);
+            hi[i] = hi[i].max(c[i]);
+        }
+    }
+    (lo, hi)
+}
+
+/// "node at (x1, x2) = (1, 2) (gmsh node 17)".
+fn where_node(mesh: &MeshData, node: usize) -> String {
+    let x = mesh.mesh.coords[node];
+    let tag = mesh.node_tags.as_ref().and_then(|t| t.get(node)).map(|t| format!(" (gmsh node {t})")).unwrap_or_default();
+    format!("the node at (x1, x2) = ({}, {}){tag}", num(x[0]), num(x[1]))
+}
+
+fn vec3(v: [f64; 3]) -> String {
+    format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]))
+}
+
+// ---------------------------------------------------------------------------------------------
+// empty groups
+
+fn check_groups(p: &Problem, mesh: &MeshData) -> Result<()> {
+    let s = &p.spec;
+    let empty = |span: std::ops::Range<usize>, key: &str, name: &str, what: &str| p.error_at(span, key, format!("the group '{}' {what}", quote(name)));
+    for (i, b) in s.boundary.iter().enumerate() {
+        let g = &b.get_ref().group;
+        if mesh.nodes(g.get_ref()).is_some_and(|n| n.is_empty()) {
+            return Err(empty(g.span(), &format!("boundary[{i}].group"), g.get_ref(), "has no nodes: the support holds nothing"));
+        }
+    }
+    for (i, l) in s.load.iter().enumerate() {
+        let ls = l.get_ref();
+        let (g, key) = (&ls.group, format!("load[{i}].group"));
+        let name = g.get_ref();
+        match ls.kind {
+            LoadKind::Line => {
+                if mesh.curves.get(name).is_some_and(|c| c.is_empty()) {
+                    return Err(empty(g.span(), &key, name, "has no edges (2-node lines): a line load acts along the edges of a curve group"));
+                }
+            }
+            LoadKind::Surface | LoadKind::Pressure => {
+                if mesh.surfaces.get(name).is_some_and(|c| c.is_empty()) {
+                    let kind = if ls.kind == LoadKind::Pressure { "pressure" } else { "surface load" };
+                    return Err(empty(g.span(), &key, name, &format!("has no cells: a {kind} acts over the cells of a surface group")));
+                }
+            }
+            LoadKind::Point => {
+                if mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).is_some_and(|n| n.is_empty()) {
+                    return Err(empty(g.span(), &key, name, "has no nodes: the point load acts nowhere"));
+                }
+            }
+        }
+    }
+    for (i, pu) in s.punch.iter().enumerate() {
+        if let Some(g) = &pu.get_ref().group {
+            if mesh.nodes(g.get_ref()).is_some_and(|n| n.is_empty()) {
+                return Err(empty(g.span(), &format!("punch[{i}].group"), g.get_ref(), "has no nodes: the punch has no point that may touch"));
+            }
+        }
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------------
+// punches at the start
+
+/// The penetration tolerance of punch `i`: its own, or [`DEFAULT_PENETRATION`] h.
+fn penetration_tolerance(p: &Problem, setup: &Setup, i: usize) -> f64 {
+    p.spec.punch[i].get_ref().penetration_tolerance.map(|t| t.0).unwrap_or(DEFAULT_PENETRATION * setup.section.thickness())
+}
+
+/// Where punch `i` starts; Err when it starts inside the plate.
+fn punch_start(p: &Problem, setup: &Setup, i: usize, size: f64) -> Result<PunchStart> {
+    let pair = &setup.model.contacts[i];
+    let info = &setup.punches[i];
+    let key = format!("punch[{i}]");
+    let gaps = start_gaps(pair);
+    let first = first_gap(&gaps);
+    let tol = penetration_tolerance(p, setup, i);
+    if let Some(f) = &first {
+        if f.gap < -tol {
+            let face = face_word(info.face);
+            return Err(p.error_at(
+                p.spec.punch[i].span(),
+                &key,
+                format!(
+                    "'{}' starts inside the plate: {} deep at {} on the {face} face (x3 = {}), more than the penetration tolerance {}; move the punch out of the plate",
+                    quote(&info.name),
+                    num(-f.gap),
+                    where_node(&setup.mesh, f.node),
+                    num(info.z),
+                    num(tol)
+                ),
+            ));
+        }
+    }
+    let touch = (TOUCH * size).max(p.spec.punch[i].get_ref().penetration_tolerance.map(|t| t.0).unwrap_or(0.0));
+    let mut holding: Vec<PointGap> = gaps.iter().filter(|g| g.gap <= touch).copied().collect();
+    let touching = !holding.is_empty();
+    if !touching && pair.drive.is_some() {
+        if let Some(f) = &first {
+            holding = gaps.iter().filter(|g| g.gap <= f.gap + touch).copied().collect();
+        }
+    }
+    Ok(PunchStart { key, name: info.name.clone(), first, holding, touching })
+}
+
+fn face_word(f: Face) -> &'static str {
+    match f {
+        Face::Top => "top",
+        Face::Bottom => "bottom",
+    }
+}
+
+/// Outward normal of a face of the plate.
+fn face_normal(f: Face) -> Vector3<f64> {
+    match f {
+        Face::Top => Vector3::new(0.0, 0.0, 1.0),
+        Face::Bottom => Vector3::new(0.0, 0.0, -1.0),
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// rigid-body motions
+
+/// Err when the supports and the punches at the start leave a rigid motion free; else a line for
+/// the summary saying what holds them.
+fn check_rigid_modes(p: &Problem, setup: &Setup, starts: &[PunchStart], size: f64) -> Result<String> {
+    let (lo, hi) = bbox(&setup.mesh);
+    let (dm, dp) = (setup.section.delta_minus, setup.section.delta_plus);
+    let mut modes = RigidModes::new([0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (dm + dp)], size);
+    let coords = &setup.mesh.mesh.coords;
+    let dofs = &setup.model.dofs;
+    let per = dofs.dofs_per_node();
+    for (d, &e) in dofs.equations().iter().enumerate() {
+        if e == PRESCRIBED {
+            let (n, c) = (d / per, d % per);
+            let z = if c < 3 { dm } else { dp };
+            modes.hold_component([coords[n][0], coords[n][1], z], c % 3);
+        }
+    }
+    let supports_only = modes.describe_free();
+    let mut holders = Vec::new();
+    for s in starts {
+        for g in &s.holding {
+            modes.hold(g.x, g.normal);
+        }
+        if !s.holding.is_empty() {
+            holders.push(format!("'{}'", s.name));
+        }
+    }
+    match modes.describe_free() {
+        None => Ok(match supports_only {
+            None => "all six held by the supports".into(),
+            Some(_) => format!("all six held by the supports and the punch{} {} at the start", if holders.len() > 1 { "es" } else { "" }, holders.join(", ")),
+        }),
+        Some(free) => {
+            let basis = modes.free_basis();
+            let involves = |idx: &[usize]| basis.iter().any(|b| idx.iter().any(|&i| b[i].abs() > 1e-6 * b.norm()));
+            let mut advice = Vec::new();
+            if involves(&[0, 1, 5]) {
+                advice.push("fix = [\"v1\", \"v2\"] on a point group and fix = [\"v2\"] on a second point, or symmetry conditions (symmetry_x1, symmetry_x2 on symmetry edges)");
+            }
+            if involves(&[2, 3, 4]) {
+                advice.push("fix = [\"simply_supported\"] on an edge or on three points not in a line, or a punch touching the plate at the start");
+            }
+            Err(StampError::Input {
+                file: file(p),
+                message: format!("boundary: {free} (no support holds them and no punch touches the plate there at the start): add supports, e.g. {}", advice.join("; ")),
+            })
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// warnings
+
+fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<String> {
+    let mut out = Vec::new();
+    let h = setup.section.thickness();
+    for (i, (info, pair)) in setup.punches.iter().zip(&setup.model.contacts).enumerate() {
+        let head = format!("{}: punch[{i}] ('{}')", file(p), quote(&info.name));
+        let n_face = face_normal(info.face);
+        let face = face_word(info.face);
+        let sign = if info.face == Face::Top { "+" } else { "-" };
+        // the prescribed motion or force moves it away from its face
+        let (push, what) = match &pair.drive {
+            Some(f) => (Vector3::from(f.direction) * f.force, format!("its force {} along {}", num(f.force), vec3(f.direction))),
+            None => (Vector3::from(pair.motion), format!("its motion {}", vec3(pair.motion))),
+        };
+        if push.norm() > 0.0 && push.dot(&n_face) > 1e-9 * push.norm() {
+            out.push(format!("{head}: {what} moves it away from its contact face ({face}, outward normal {sign}x3): it will not press the plate"));
+        }
+        // the punch is on the other side of the plate
+        let other = match info.face {
+            Face::Top => (Face::Bottom, setup.section.delta_minus),
+            Face::Bottom => (Face::Top, setup.section.delta_plus),
+        };
+        let other_first = pair
+            .points
+            .iter()
+            .filter_map(|q| gap_at(&*pair.surface, &Vector3::new(q.x_ref[0], q.x_ref[1], other.1)).map(|g| g.0))
+            .fold(f64::INFINITY, f64::min);
+        if let Some(first) = starts[i].first {
+            if other_first < first.gap - 0.5 * h {
+                out.push(format!(
+                    "{head}: it is on the {} side of the plate (first gap {} to the {} face) but its contact face is the {face} face (first gap {}): set face = \"{}\"?",
+                    face_word(other.0),
+                    num(other_first),
+                    face_word(other.0),
+                    num(first.gap),
+                    face_word(other.0)
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// After a run: the punches that had no node in contact at any step recorded in `summary`
+/// (summary.json), one warning each.
+pub fn never_touched(p: &Problem, summary: &Path) -> Vec<String> {
+    let Ok(text) = std::fs::read_to_string(summary) else { return Vec::new() };
+    let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
+    let Some(steps) = json["steps"].as_array() else { return Vec::new() };
+    let converged: Vec<&serde_json::Value> = steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).collect();
+    if converged.is_empty() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for i in 0..p.spec.punch.len() {
+        let name = p.punch_name(i);
+        let counts: Vec<u64> = converged.iter().filter_map(|s| s["punches"][&name]["active_nodes"].as_u64()).collect();
+        if counts.len() == converged.len() && counts.iter().all(|&c| c == 0) {
+            out.push(format!(
+                "{}: punch[{i}] ('{}') never touched the plate: no node was in contact at any of the {} recorded steps; check its position, motion and face",
+                file(p),
+                quote(&name),
+                converged.len()
+            ));
+        }
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// summary
+
+/// Total force of load `i` at load factor 1.
+fn load_total(p: &Problem, mesh: &MeshData, i: usize) -> [f64; 3] {
+    let ls = p.spec.load[i].get_ref();
+    let name = ls.group.get_ref();
+    let area = |cells: &[usize]| cells.iter().map(|&c| stamp::mesh::quad_signed_area(&mesh.mesh.cell_coords(c)).abs()).sum::<f64>();
+    match ls.kind {
+        LoadKind::Line => {
+            let len: f64 = mesh.curves.get(name).map(|s| s.iter().map(|s| {
+                let (a, b) = (mesh.mesh.coords[s[0]], mesh.mesh.coords[s[1]]);
+                (a[0] - b[0]).hypot(a[1] - b[1])
+            }).sum()).unwrap_or(0.0);
+            ls.force.unwrap().0.map(|f| f * len)
+        }
+        LoadKind::Surface => {
+            let a = mesh.surfaces.get(name).map(|c| area(c)).unwrap_or(0.0);
+            ls.force.unwrap().0.map(|f| f * a)
+        }
+        LoadKind::Pressure => {
+            let a = mesh.surfaces.get(name).map(|c| area(c)).unwrap_or(0.0);
+            let q = ls.pressure.unwrap().0;
+            [0.0, 0.0, if ls.face == Some(LoadFace::Top) { -q * a } else { q * a }]
+        }
+        LoadKind::Point => {
+            let n = mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).map(|v| v.len()).unwrap_or(0);
+            ls.force.unwrap().0.map(|f| f * n as f64)
+        }
+    }
+}
+
+/// What kind of group `name` is, with its size.
+fn group_line(mesh: &MeshData, name: &str) -> String {
+    let nodes = plural(mesh.nodes(name).map(|v| v.len()).unwrap_or(0), "node");
+    if let Some(c) = mesh.surfaces.get(name) {
+        format!("surface, {nodes}, {}", plural(c.len(), "cell"))
+    } else if let Some(c) = mesh.curves.get(name) {
+        format!("curve, {nodes}, {}", plural(c.len(), "edge"))
+    } else if mesh.points.contains_key(name) {
+        format!("point, {nodes}")
+    } else {
+        nodes
+    }
+}
+
+/// "1 node", "3 nodes".
+fn plural(n: usize, word: &str) -> String {
+    format!("{n} {word}{}", if n == 1 { "" } else { "s" })
+}
+
+fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> String {
+    let s = &p.spec;
+    let mesh = &setup.mesh;
+    let mut o = String::new();
+    let _ = writeln!(o, "problem: {}", p.path.display());
+    if let Some(t) = &s.title {
+        let _ = writeln!(o, "title: {}", quote(t));
+    }
+    let source = match &s.mesh.get_ref().file {
+        Some(f) => format!("gmsh file {}", quote(f.get_ref())),
+        None => {
+            let r = s.mesh.get_ref().rectangle.as_ref().unwrap();
+            format!("rectangle x = [{}, {}], y = [{}, {}], {} x {} cells", num(r.x[0]), num(r.x[1]), num(r.y[0]), num(r.y[1]), r.n[0], r.n[1])
+        }
+    };
+    let _ = writeln!(o, "mesh: {source}: {} nodes, {} elements", mesh.mesh.num_nodes(), mesh.mesh.num_cells());
+    let ps = s.plate.get_ref();
+    let _ = writeln!(
+        o,
+        "plate: thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}",
+        num(setup.section.thickness()),
+        num(setup.section.delta_minus),
+        num(setup.section.delta_plus),
+        num(ps.young.0),
+        num(ps.nu.0),
+        format!("{:?}", ps.kinematics).to_lowercase(),
+        if ps.plane_strain { ", plane strain" } else { "" }
+    );
+    let nodal = setup.model.dofs.num_equations();
+    let drives = setup.model.num_drives();
+    let _ = writeln!(
+        o,
+        "unknowns: {} equations ({nodal} nodal of {} dofs, {} held by supports; {drives} punch travel{})",
+        setup.model.num_equations(),
+        setup.model.dofs.num_dofs(),
+        setup.model.dofs.num_dofs() - nodal,
+        if drives == 1 { "" } else { "s" }
+    );
+    // groups in use
+    let mut groups: Vec<(String, Vec<String>)> = Vec::new();
+    let mut use_group = |name: &str, key: String| match groups.iter_mut().find(|g| g.0 == name) {
+        Some(g) => g.1.push(key),
+        None => groups.push((name.to_string(), vec![key])),
+    };
+    for (i, b) in s.boundary.iter().enumerate() {
+        use_group(b.get_ref().group.get_ref(), format!("boundary[{i}]"));
+    }
+    for (i, l) in s.load.iter().enumerate() {
+        use_group(l.get_ref().group.get_ref(), format!("load[{i}]"));
+    }
+    for (i, pu) in s.punch.iter().enumerate() {
+        if let Some(g) = &pu.get_ref().group {
+            use_group(g.get_ref(), format!("punch[{i}]"));
+        }
+    }
+    if !groups.is_empty() {
+        let _ = writeln!(o, "groups:");
+        for (name, keys) in &groups {
+            let _ = writeln!(o, "  '{}' ({}): {}", quote(name), group_line(mesh, name), keys.join(", "));
+        }
+    }
+    let _ = writeln!(o, "supports:");
+    if ps.plane_strain {
+        let _ = writeln!(o, "  plate.plane_strain: v1- = v1+ = 0 at every node");
+    }
+    for (i, b) in s.boundary.iter().enumerate() {
+        let bs = b.get_ref();
+        let mut what: Vec<String> = Vec::new();
+        if !bs.fix.is_empty() {
+            what.push(format!("fix {}", bs.fix.iter().map(|d| d.word.as_str()).collect::<Vec<_>>().join(", ")));
+        }
+        for (k, v) in &bs.prescribe {
+            what.push(format!("{} = {} x load factor", k.0, num(v.0)));
+        }
+        let _ = writeln!(o, "  boundary[{i}] on '{}': {}", quote(bs.group.get_ref()), what.join("; "));
+    }
+    if s.boundary.is_empty() && !ps.plane_strain {
+        let _ = writeln!(o, "  none");
+    }
+    if !s.load.is_empty() {
+        let _ = writeln!(o, "loads (at load factor 1):");
+        let mut sum = [0.0; 3];
+        for (i, l) in s.load.iter().enumerate() {
+            let ls = l.get_ref();
+            let t = load_total(p, mesh, i);
+            for c in 0..3 {
+                sum[c] += t[c];
+            }
+            let kind = format!("{:?}", ls.kind).to_lowercase();
+            let face = format!("{:?}", ls.face.unwrap_or_default()).to_lowercase();
+            let _ = writeln!(o, "  load[{i}]: {kind} on '{}', face {face}: total force {}", quote(ls.group.get_ref()), vec3(t));
+        }
+        let _ = writeln!(o, "  all loads: total force {}", vec3(sum));
+    }
+    if !setup.punches.is_empty() {
+        let _ = writeln!(o, "punches:");
+    }
+    for (i, ((info, pair), st)) in setup.punches.iter().zip(&setup.model.contacts).zip(starts).enumerate() {
+        let drive = match &pair.drive {
+            Some(f) => format!("driven by force {} along {}", num(f.force), vec3(f.direction)),
+            None => format!("driven by motion {}", vec3(pair.motion)),
+        };
+        let gap = match &st.first {
+            Some(f) => format!(
+                "first gap {} at {}{}",
+                num(f.gap),
+                where_node(mesh, f.node),
+                if st.touching { format!(" (touching at {})", plural(st.holding.len(), "node")) } else { String::new() }
+            ),
+            None => "no first gap".into(),
+        };
+        let _ = writeln!(
+            o,
+            "  punch[{i}] '{}': {}, {} face (x3 = {}), {drive}, {} candidate nodes, {gap}",
+            quote(&info.name),
+            info.surface.describe(),
+            face_word(info.face),
+            num(info.z),
+            pair.points.len()
+        );
+    }
+    let _ = writeln!(o, "rigid-body motions: {rigid}");
+    let targets = &setup.targets;
+    let _ = write!(o, "load factors: {} target{} up to {}", targets.len(), if targets.len() == 1 { "" } else { "s" }, num(targets.iter().cloned().fold(0.0, f64::max)));
+    o
+}
