@@ -269,14 +269,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
         let n_face = face_normal(info.face);
         let face = face_word(info.face);
         let sign = if info.face == Face::Top { "+" } else { "-" };
-        // the prescribed motion or force moves it away from its face
-        let (push, what) = match &pair.drive {
-            Some(f) => (Vector3::from(f.direction) * f.force, format!("its force {} along {}", num(f.force), vec3(f.direction))),
-            None => (Vector3::from(pair.motion), format!("its motion {}", vec3(pair.motion))),
-        };
-        if push.norm() > 0.0 && push.dot(&n_face) > 1e-9 * push.norm() {
-            out.push(format!("{head}: {what} moves it away from its contact face ({face}, outward normal {sign}x3): it will not press the plate"));
-        }
+        let mut wrong_side = false;
         // the punch is on the other side of the plate
         let other = match info.face {
             Face::Top => (Face::Bottom, setup.section.delta_minus),
@@ -289,6 +282,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
             .fold(f64::INFINITY, f64::min);
         if let Some(first) = starts[i].first {
             if other_first < first.gap - 0.5 * h {
+                wrong_side = true;
                 out.push(format!(
                     "{head}: it is on the {} side of the plate (first gap {} to the {} face) but its contact face is the {face} face (first gap {}): set face = \"{}\"?",
                     face_word(other.0),
@@ -298,6 +292,15 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
                     face_word(other.0)
                 ));
             }
+        }
+        // the prescribed motion or force moves it away from its face (said only when the punch is
+        // on the face's side: else the warning above says what is wrong)
+        let (push, what) = match &pair.drive {
+            Some(f) => (Vector3::from(f.direction) * f.force, format!("its force {} along {}", num(f.force), vec3(f.direction))),
+            None => (Vector3::from(pair.motion), format!("its motion {}", vec3(pair.motion))),
+        };
+        if !wrong_side && push.norm() > 0.0 && push.dot(&n_face) > 1e-9 * push.norm() {
+            out.push(format!("{head}: {what} moves it away from its contact face ({face}, outward normal {sign}x3): it will not press the plate"));
         }
     }
     out

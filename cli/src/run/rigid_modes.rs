@@ -147,7 +147,7 @@ impl RigidModes {
             let point = if across.iter().all(|j| translations.contains(j)) {
                 None
             } else {
-                let p = self.origin + m.rotation.cross(&m.translation) / m.rotation.norm_squared();
+                let p = self.clean(self.origin + m.rotation.cross(&m.translation) / m.rotation.norm_squared());
                 Some(format!("({}, {}) = ({}, {})", AXES[across[0]], AXES[across[1]], num(p[across[0]]), num(p[across[1]])))
             };
             rotations.push((i, point));
@@ -185,6 +185,12 @@ impl RigidModes {
         Some(format!("{} {verb} held by nothing", join_and(&parts.iter().map(|s| s.as_str()).collect::<Vec<_>>())))
     }
 
+    /// A point with round-off (below 1e-9 of the model's size and position) set to zero.
+    fn clean(&self, p: Vector3<f64>) -> Vector3<f64> {
+        let tiny = 1e-9 * (self.scale + self.origin.norm());
+        p.map(|x| if x.abs() < tiny { 0.0 } else { x })
+    }
+
     /// A motion that is not a coordinate translation or rotation, in words.
     fn describe_motion(&self, m: &FreeMotion) -> String {
         let w = m.rotation.norm() * self.scale;
@@ -193,7 +199,7 @@ impl RigidModes {
             return format!("the translation along ({}, {}, {})", num(d[0]), num(d[1]), num(d[2]));
         }
         let axis = m.rotation.normalize();
-        let p = self.origin + m.rotation.cross(&m.translation) / m.rotation.norm_squared();
+        let p = self.clean(self.origin + m.rotation.cross(&m.translation) / m.rotation.norm_squared());
         format!("the rotation about the axis along ({}, {}, {}) through ({}, {}, {})", num(axis[0]), num(axis[1]), num(axis[2]), num(p[0]), num(p[1]), num(p[2]))
     }
 }
@@ -233,7 +239,11 @@ pub fn num(x: f64) -> String {
         let s = s.trim_end_matches('0').trim_end_matches('.');
         if s == "-0" { "0".into() } else { s.to_string() }
     } else {
-        format!("{x:.4e}")
+        let s = format!("{x:.4e}");
+        match s.split_once('e') {
+            Some((m, e)) => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
+            None => s,
+        }
     }
 }
 
@@ -301,7 +311,7 @@ mod tests {
         m.hold_component([0.0, 0.0, 0.0], 1);
         m.hold_component([1e3, 0.0, 0.0], 1);
         m.hold_component([0.0, 0.0, -5e-5], 0);
-        assert_eq!(m.describe_free().unwrap(), "the rotation about x2 (about the axis through (x1, x3) = (0, -5.0000e-5)) is held by nothing");
+        assert_eq!(m.describe_free().unwrap(), "the rotation about x2 (about the axis through (x1, x3) = (0, -5e-5)) is held by nothing");
         m.hold_component([0.0, 0.0, 5e-5], 0);
         assert!(m.describe_free().is_none(), "{:?}", m.describe_free());
     }
@@ -310,7 +320,9 @@ mod tests {
     fn numbers_are_short() {
         assert_eq!(num(0.30000000000000004), "0.3");
         assert_eq!(num(-2.5), "-2.5");
-        assert_eq!(num(1e-7), "1.0000e-7");
+        assert_eq!(num(1e-7), "1e-7");
+        assert_eq!(num(-5.12345e-9), "-5.1235e-9");
+        assert_eq!(num(2.5e7), "2.5e7");
         assert_eq!(num(0.0), "0");
     }
 }

@@ -1,0 +1,246 @@
+//! `stamp check` and the checks `stamp run` makes before it solves: the model's summary, rigid-body
+//! motions held by nothing, a punch that starts inside the plate, empty groups (errors, no solve,
+//! nothing written), and the warnings for punches that move away, sit on the other side of the
+//! plate or never touch it.
+
+mod common;
+use common::*;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+struct Out {
+    ok: bool,
+    stdout: String,
+    stderr: String,
+}
+
+fn stamp(args: &[&str], file: &Path) -> Out {
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).args(args).arg(file).output().unwrap();
+    Out { ok: o.status.success(), stdout: String::from_utf8_lossy(&o.stdout).into_owned(), stderr: String::from_utf8_lossy(&o.stderr).into_owned() }
+}
+
+fn check(file: &Path) -> Out {
+    stamp(&["check"], file)
+}
+
+/// A shipped problem file with some text replaced, written to a fresh folder (the mesh files of
+/// meshes/ copied along).
+fn variant(name: &str, shipped: &str, edits: &[(&str, &str)]) -> PathBuf {
+    let dir = temp_dir(name);
+    let mut text = std::fs::read_to_string(repo().join("meshes").join(shipped)).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{shipped} has no '{from}'");
+        text = text.replacen(from, to, 1);
+    }
+    for msh in ["paper-r100.msh", "sphere-ss-full.msh", "sphere-demo.msh"] {
+        std::fs::copy(repo().join("meshes").join(msh), dir.join(msh)).unwrap();
+    }
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn write(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = temp_dir(name);
+    for (f, text) in files {
+        std::fs::write(dir.join(f), text).unwrap();
+    }
+    dir.join(files[0].0)
+}
+
+#[test]
+fn every_shipped_problem_passes_and_the_summary_has_the_right_numbers() {
+    for entry in std::fs::read_dir(repo().join("meshes")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let o = check(&path);
+            assert!(o.ok, "{}: {}", path.display(), o.stderr);
+            assert!(o.stderr.is_empty(), "{}: no warnings expected: {}", path.display(), o.stderr);
+            assert!(o.stdout.contains("rigid-body motions: all six held") && o.stdout.contains("check: no errors"), "{}", o.stdout);
+        }
+    }
+    // sphere-ss: 11 x 11 nodes with 6 unknowns each; left, bottom, right and top hold two
+    // components each at their 11 nodes, right and top the same two at their common corner; one
+    // more unknown for the force-driven punch's travel
+    let o = check(&repo().join("meshes/sphere-ss.toml"));
+    let held = 4 * 11 * 2 - 2;
+    let nodal = 6 * 121 - held;
+    assert!(o.stdout.contains("121 nodes, 100 elements"), "{}", o.stdout);
+    assert!(o.stdout.contains(&format!("unknowns: {} equations ({nodal} nodal of 726 dofs, {held} held by supports; 1 punch travel)", nodal + 1)), "{}", o.stdout);
+    assert!(o.stdout.contains("'left' (curve, 11 nodes, 10 edges): boundary[0]"), "{}", o.stdout);
+    assert!(o.stdout.contains("driven by force 500 along (0, 0, -1), 121 candidate nodes, first gap 0 at the node at (x1, x2) = (0, 0) (touching at 1 node)"), "{}", o.stdout);
+    // plane-cantilever: the platen 2 below the bottom face; pressure 3 on the 40 x 8 top face
+    let o = check(&repo().join("meshes/plane-cantilever.toml"));
+    assert!(o.stdout.contains("first gap 2 at the node at (x1, x2) = (0, 0)\n"), "{}", o.stdout);
+    assert!(o.stdout.contains("load[0]: pressure on 'all', face top: total force (0, 0, -960)"), "{}", o.stdout);
+}
+
+#[test]
+fn the_paper_strip_is_held_by_symmetry_and_the_cylinder_touching_at_the_start() {
+    let o = check(&repo().join("meshes/paper-r100.toml"));
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stdout.contains("all six held by the supports and the punch 'cylinder' at the start"), "{}", o.stdout);
+    assert!(o.stdout.contains("82 nodes, 40 elements") && o.stdout.contains("load[0]: line on 'end', face mid: total force (0, 0, 20)"), "{}", o.stdout);
+    // the same strip with the fixed cylinder 0.5 above it: nothing holds the translation along x3
+    let lifted = variant("paper-lifted", "paper-r100.toml", &[("point = [0.0, 0.0, 101.0]", "point = [0.0, 0.0, 101.5]")]);
+    let o = check(&lifted);
+    assert!(!o.ok);
+    assert!(o.stderr.contains("paper-lifted.toml: boundary: the translation along x3 is held by nothing"), "{}", o.stderr);
+    assert!(o.stderr.contains("simply_supported"), "the advice fits the free motion: {}", o.stderr);
+    assert!(!o.stderr.contains("x1 and x2"), "{}", o.stderr);
+    // ... but a force-driven cylinder comes down onto the plate: its travel is an unknown
+    let pressed = variant("paper-pressed", "paper-r100.toml", &[("point = [0.0, 0.0, 101.0]", "point = [0.0, 0.0, 101.5]"), ("motion = [0.0, 0.0, 0.0]", "force = -20.0")]);
+    let o = check(&pressed);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stdout.contains("first gap 0.5 at"), "{}", o.stdout);
+}
+
+/// A square plate held only along its edges by simply_supported, under a pressure.
+fn simply_supported(n: usize) -> String {
+    format!(
+        r#"[mesh]
+rectangle = {{ x = [-50.0, 50.0], y = [-50.0, 50.0], n = [{n}, {n}] }}
+[plate]
+thickness = 1.0
+E = 2.1e5
+nu = 0.3
+[[boundary]]
+group = "boundary"
+fix = ["simply_supported"]
+[[load]]
+type = "pressure"
+group = "all"
+pressure = 0.01
+face = "top"
+"#
+    )
+}
+
+#[test]
+fn a_simply_supported_plate_is_refused_at_once_with_the_free_motions_named() {
+    let path = write("ss-plate", &[("ss.toml", &simply_supported(200))]);
+    let out = path.parent().unwrap().join("out");
+    let t = Instant::now();
+    let o = stamp(&["run", "-q", "--out", out.to_str().unwrap()], &path);
+    let seconds = t.elapsed().as_secs_f64();
+    eprintln!("stamp run on a 200 x 200 simply supported plate refused in {seconds:.2} s");
+    assert!(!o.ok);
+    assert!(
+        o.stderr.contains("ss.toml: boundary: the translations along x1 and x2 and the rotation about x3 are held by nothing")
+            && o.stderr.contains("fix = [\"v1\", \"v2\"] on a point group"),
+        "{}",
+        o.stderr
+    );
+    assert!(o.stderr.len() < 600, "a short message: {}", o.stderr);
+    assert!(seconds < 5.0, "{seconds} s");
+    assert!(!out.exists(), "nothing is written before the checks pass");
+    // a pin at one corner leaves the rotation about x3 about that corner; a roller at a second one
+    // holds it
+    let pinned = simply_supported(4) + "[[boundary]]\ngroup = \"corner_ll\"\nfix = [\"v1\", \"v2\"]\n";
+    let o = check(&write("ss-pinned", &[("pinned.toml", &pinned)]));
+    assert!(!o.ok && o.stderr.contains("boundary: the rotation about x3 (about the axis through (x1, x2) = (-50, -50)) is held by nothing"), "{}", o.stderr);
+    let rolled = pinned + "[[boundary]]\ngroup = \"corner_lr\"\nfix = [\"v2\"]\n";
+    let o = check(&write("ss-rolled", &[("rolled.toml", &rolled)]));
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stdout.contains("rigid-body motions: all six held by the supports"), "{}", o.stdout);
+}
+
+#[test]
+fn a_punch_starting_inside_the_plate_is_refused() {
+    // sphere-ss's sphere 1 lower: 1 inside the top face at the centre
+    let sunk = variant("sunk", "sphere-ss.toml", &[("center = [0.0, 0.0, 200.5]", "center = [0.0, 0.0, 199.5]")]);
+    let o = check(&sunk);
+    assert!(!o.ok);
+    assert!(o.stderr.contains("sunk.toml: line ") && o.stderr.contains("punch[0]: 'sphere' starts inside the plate: 1 deep at the node at (x1, x2) = (0, 0) on the top face (x3 = 0.5)"), "{}", o.stderr);
+    let o = stamp(&["run", "-q", "--out", sunk.parent().unwrap().join("out").to_str().unwrap()], &sunk);
+    assert!(!o.ok && o.stderr.contains("starts inside the plate") && !sunk.parent().unwrap().join("out").exists(), "{}", o.stderr);
+    // 5e-4 inside: more than its penetration_tolerance 1e-6, less than the default 1e-3 h
+    let shallow = variant("shallow", "sphere-ss.toml", &[("center = [0.0, 0.0, 200.5]", "center = [0.0, 0.0, 200.4995]")]);
+    let o = check(&shallow);
+    assert!(!o.ok && o.stderr.contains("5e-4 deep") && o.stderr.contains("tolerance 1e-6"), "{}", o.stderr);
+    let tolerated = variant("tolerated", "sphere-ss.toml", &[("center = [0.0, 0.0, 200.5]", "center = [0.0, 0.0, 200.4995]"), ("penetration_tolerance = 1e-6", "")]);
+    assert!(check(&tolerated).ok);
+    // a gmsh mesh: the node's gmsh tag
+    let full = variant("sunk-full", "sphere-ss-full.toml", &[("center = [0.0, 0.0, 200.5]", "center = [0.0, 0.0, 199.5]")]);
+    let g = stamp::io::read_msh(&repo().join("meshes/sphere-ss-full.msh")).unwrap();
+    let centre = g.mesh.coords.iter().position(|c| c[0] == 0.0 && c[1] == 0.0).unwrap();
+    let o = check(&full);
+    assert!(!o.ok && o.stderr.contains(&format!("1 deep at the node at (x1, x2) = (0, 0) (gmsh node {})", g.node_tags[centre])), "{}", o.stderr);
+}
+
+/// tests/data/rect.msh (a 2 x 1 plate, 4 x 2 quadrilaterals) without the line elements of the
+/// curves "right" and "load", and with a surface group "hole" that has no cells.
+fn rect_with_empty_groups() -> String {
+    let text = std::fs::read_to_string(repo().join("tests/data/rect.msh")).unwrap();
+    let text = text.replace("5\n0 1 \"origin\"", "6\n0 1 \"origin\"").replace("2 7 \"plate\"\n", "2 7 \"plate\"\n2 8 \"hole\"\n");
+    let (head, tail) = text.split_once("$Elements\n").unwrap();
+    let (elements, rest) = tail.split_once("$EndElements").unwrap();
+    let mut lines = elements.lines();
+    lines.next(); // header
+    let mut blocks = Vec::new();
+    let mut count = 0;
+    while let Some(h) = lines.next() {
+        let f: Vec<usize> = h.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        let body: Vec<&str> = (0..f[3]).map(|_| lines.next().unwrap()).collect();
+        if !(f[0] == 1 && (f[1] == 2 || f[1] == 3)) {
+            count += f[3];
+            blocks.push(format!("{h}\n{}", body.join("\n")));
+        }
+    }
+    format!("{head}$Elements\n{} {count} 1 22\n{}\n$EndElements{rest}", blocks.len(), blocks.join("\n"))
+}
+
+#[test]
+fn loads_and_supports_on_empty_groups_are_refused() {
+    let msh = rect_with_empty_groups();
+    let base = "[mesh]\nfile = \"rect.msh\"\n[plate]\nthickness = 0.1\nE = 1000.0\nnu = 0.3\n[[boundary]]\ngroup = \"bottom\"\nfix = [\"clamped\"]\n";
+    let fine = base.to_string() + "[[load]]\ntype = \"line\"\ngroup = \"bottom\"\nforce = [0.0, 0.0, 1.0]\n";
+    let o = check(&write("empty-none", &[("fine.toml", &fine), ("rect.msh", &msh)]));
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stdout.contains("'bottom' (curve, 5 nodes, 4 edges)"), "{}", o.stdout);
+    let cases = [
+        ("support", base.to_string() + "[[boundary]]\ngroup = \"right\"\nfix = [\"v1\"]\n", "boundary[1].group: the group 'right' has no nodes"),
+        ("line", base.to_string() + "[[load]]\ntype = \"line\"\ngroup = \"load\"\nforce = [0.0, 0.0, 1.0]\n", "load[0].group: the group 'load' has no edges"),
+        ("pressure", base.to_string() + "[[load]]\ntype = \"pressure\"\ngroup = \"hole\"\npressure = 1.0\nface = \"top\"\n", "load[0].group: the group 'hole' has no cells: a pressure"),
+        ("punch", base.to_string() + "[[punch]]\nshape = \"plane\"\npoint = [0.0, 0.0, 1.0]\nnormal = [0.0, 0.0, -1.0]\nmotion = [0.0, 0.0, -0.5]\ngroup = \"hole\"\n", "punch[0].group: the group 'hole' has no nodes"),
+    ];
+    for (name, text, want) in cases {
+        let file = format!("{name}.toml");
+        let o = check(&write(&format!("empty-{name}"), &[(&file, &text), ("rect.msh", &msh)]));
+        assert!(!o.ok, "{name}: accepted");
+        assert!(o.stderr.contains(&file) && o.stderr.contains("line ") && o.stderr.contains(want), "{name}: {}", o.stderr);
+    }
+}
+
+#[test]
+fn punches_that_move_away_or_sit_on_the_other_side_are_warned_about() {
+    // a displacement-driven sphere moving up, away from the top face: warned before the run, and
+    // after it, as it never touched the plate; the run itself succeeds
+    let away = variant("away", "sphere-ss-displacement.toml", &[("motion = [0.0, 0.0, -0.9]", "motion = [0.0, 0.0, 0.9]"), ("plot = true", "plot = false")]);
+    let o = check(&away);
+    assert!(o.ok && o.stdout.contains("check: no errors, 1 warning"), "{}{}", o.stdout, o.stderr);
+    assert!(o.stderr.contains("warning: ") && o.stderr.contains("away.toml: punch[0] ('sphere'): its motion (0, 0, 0.9) moves it away from its contact face (top, outward normal +x3)"), "{}", o.stderr);
+    let out = away.parent().unwrap().join("out");
+    let o = stamp(&["run", "-q", "--out", out.to_str().unwrap()], &away);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stderr.contains("moves it away"), "{}", o.stderr);
+    assert!(o.stderr.contains("punch[0] ('sphere') never touched the plate: no node was in contact at any of the 5 recorded steps"), "{}", o.stderr);
+    // a force-driven sphere pushed up
+    let up = variant("up", "sphere-ss.toml", &[("force = 500.0", "force = 500.0\ndirection = [0.0, 0.0, 1.0]")]);
+    let o = check(&up);
+    assert!(o.ok && o.stderr.contains("its force 500 along (0, 0, 1) moves it away from its contact face (top"), "{}", o.stderr);
+    // the sphere above the plate, its contact face the bottom one
+    let wrong = variant("wrong-side", "sphere-ss-displacement.toml", &[("name = \"sphere\"", "name = \"sphere\"\nface = \"bottom\"")]);
+    let o = check(&wrong);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stderr.contains("punch[0] ('sphere'): it is on the top side of the plate (first gap 0 to the top face) but its contact face is the bottom face (first gap 1): set face = \"top\"?"), "{}", o.stderr);
+    assert!(!o.stderr.contains("moves it away"), "its motion is towards the plate: {}", o.stderr);
+    // the platen below the cantilever, its contact face the top one
+    let wrong = variant("wrong-platen", "plane-cantilever.toml", &[("face = \"bottom\"\npenetration", "face = \"top\"\npenetration")]);
+    let o = check(&wrong);
+    assert!(o.ok && o.stderr.contains("it is on the bottom side of the plate"), "{}", o.stderr);
+    // a run that touches says nothing after it
+    let o = stamp(&["run", "-q", "--out", temp_dir("touching").to_str().unwrap()], &repo().join("meshes/sphere-ss-displacement.toml"));
+    assert!(o.ok && o.stderr.is_empty(), "{}", o.stderr);
+}
