@@ -135,6 +135,11 @@ fn a_simply_supported_plate_is_refused_at_once_with_the_free_motions_named() {
     assert!(o.stderr.len() < 600, "a short message: {}", o.stderr);
     assert!(seconds < 5.0, "{seconds} s");
     assert!(!out.exists(), "nothing is written before the checks pass");
+    // the full sphere model without its centre and east supports: the sphere touching at the
+    // centre holds only what the edges already hold
+    let loose = variant("loose", "sphere-ss-full.toml", &[("[[boundary]]\ngroup = \"center\"\nfix = [\"v1\", \"v2\"]\n\n[[boundary]]\ngroup = \"east\"\nfix = [\"v2\"]\n", "")]);
+    let o = stamp(&["run", "-q", "--out", loose.parent().unwrap().join("out").to_str().unwrap()], &loose);
+    assert!(!o.ok && o.stderr.contains("loose.toml: boundary: the translations along x1 and x2 and the rotation about x3 are held by nothing"), "{}", o.stderr);
     // a pin at one corner leaves the rotation about x3 about that corner; a roller at a second one
     // holds it
     let pinned = simply_supported(4) + "[[boundary]]\ngroup = \"corner_ll\"\nfix = [\"v1\", \"v2\"]\n";
