@@ -165,6 +165,47 @@ impl Default for NewtonSettings {
     }
 }
 
+impl NewtonSettings {
+    /// Refuse settings with which a solve cannot work or cannot end: no iterations, increments that
+    /// are not positive finite numbers or in the wrong order, tolerances that are not numbers
+    /// or that floating point cannot reach, loop counts beyond any use.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(StampError::Problem(format!("Newton settings: {m}")));
+        if self.max_iterations == 0 || self.max_iterations > 100_000 {
+            return bad(format!("max_iterations must be from 1 to 100000, got {}", self.max_iterations));
+        }
+        if self.line_search_steps > 1000 || self.max_cutbacks > 1000 || self.max_restarts > 100_000 {
+            return bad(format!(
+                "line_search_steps ({}) and max_cutbacks ({}) must be at most 1000, max_restarts ({}) at most 100000",
+                self.line_search_steps, self.max_cutbacks, self.max_restarts
+            ));
+        }
+        for (name, v) in [("max_increment", self.max_increment), ("initial_increment", self.initial_increment), ("min_increment", self.min_increment)] {
+            if !(v.is_finite() && v >= f64::MIN_POSITIVE) {
+                return bad(format!("{name} must be a positive finite (normal) number, got {v:e}"));
+            }
+        }
+        if self.min_increment > self.max_increment {
+            return bad(format!("min_increment {:e} exceeds max_increment {:e}", self.min_increment, self.max_increment));
+        }
+        if !(self.growth.is_finite() && self.growth >= 1.0) {
+            return bad(format!("growth must be a finite number >= 1, got {:e}", self.growth));
+        }
+        if !(self.rel_tol.is_finite() && self.rel_tol >= 0.0 && self.abs_tol.is_finite() && self.abs_tol >= 0.0 && self.rel_tol + self.abs_tol > 0.0) {
+            return bad(format!("rel_tol ({:e}) and abs_tol ({:e}) must be finite, >= 0 and not both 0", self.rel_tol, self.abs_tol));
+        }
+        if self.rel_tol > 0.0 && self.rel_tol < 1e-16 {
+            return bad(format!("rel_tol {:e} is below round-off; the smallest allowed is 1e-16", self.rel_tol));
+        }
+        for (name, v) in [("floor_tol", self.floor_tol), ("disp_tol", self.disp_tol), ("loose_tol", self.loose_tol), ("energy_tol", self.energy_tol), ("forcing", self.forcing), ("chord_tol", self.chord_tol)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(format!("{name} must be a finite number >= 0, got {v:e}"));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// One converged load step.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct StepReport {
@@ -222,7 +263,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     /// `peak_energy` is the largest first-correction energy of the path's converged steps:
     /// the energy criterion compares with it too, because a step that starts from a good predictor
     /// has a first correction already at round-off.
-    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
         let s = &self.settings;
         let mut history = Vec::new();
         let mut du = vec![0.0; p.num_equations()];
@@ -245,9 +286,11 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         for it in 0..=s.max_iterations {
             let (ev, with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
-                None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), f64::NAN, 0.0))?, true),
+                None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true),
             };
-            let tol = s.rel_tol * ev.force_scale + s.abs_tol;
+            // the tolerance of this iterate (that of the last one when the force scale is not a number)
+            let tol = if ev.force_scale.is_finite() { s.rel_tol * ev.force_scale + s.abs_tol } else { *last_tol };
+            *last_tol = tol;
             history.push(ev.residual_norm);
             // a chord step may follow a Newton step, or a chord step that reduced |R| a hundredfold
             let chord_allowed = !last_chord || (history.len() > 1 && ev.residual_norm <= 1e-2 * history[history.len() - 2]);
@@ -257,8 +300,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             if let Some(cb) = self.on_iteration.as_mut() {
                 cb(it, ev.residual_norm, ev.force_scale);
             }
-            if !ev.residual_norm.is_finite() {
-                return Err(("the residual is not finite".into(), ev.residual_norm, tol));
+            if !ev.residual_norm.is_finite() || !ev.force_scale.is_finite() {
+                let what = if ev.residual_norm.is_nan() || ev.force_scale.is_nan() { "NaN" } else { "infinite" };
+                return Err((format!("the residual became {what} at iteration {it}"), ev.residual_norm, tol));
             }
             if it == 0 {
                 first = ev.residual_norm.max(tol);
@@ -383,7 +427,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             }
             p.add_increment(u, &du);
         }
-        Err(("no convergence".into(), f64::NAN, 0.0))
+        Err((format!("no convergence in {} iterations", s.max_iterations), history.last().copied().unwrap_or(f64::NAN), *last_tol))
     }
 }
 
@@ -397,7 +441,10 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         on_step: &mut dyn FnMut(&StepReport, &[f64], &P),
     ) -> Result<SolveSummary> {
         let start = Instant::now();
+        self.settings.validate()?;
         p.want_preconditioner(self.linear.uses_preconditioner());
+        // the tolerance of the last evaluation, for an error whose own iterate has none
+        let mut last_tol = self.settings.abs_tol;
         let mut summary = SolveSummary::default();
         let mut t = t0;
         let mut trial = u.to_vec();
@@ -416,6 +463,12 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
             while t != target {
                 let remaining = target - t;
                 let step_t = if dt >= remaining.abs() * (1.0 - 1e-12) { target } else { t + dt.copysign(remaining) };
+                if step_t == t || !step_t.is_finite() {
+                    // an increment below the round-off of t would repeat the same step for ever
+                    return Err(StampError::Problem(format!(
+                        "the load increment {dt:e} does not change the load factor {t:e} (round-off); raise min_increment"
+                    )));
+                }
                 trial.copy_from_slice(u);
                 if let (true, Some((u_prev, t_prev))) = (self.settings.extrapolate, previous.as_ref()) {
                     let ratio = (step_t - t) / (t - t_prev);
@@ -429,12 +482,23 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 p.start_step();
                 let mut restarts = 0;
                 let result = loop {
-                    match self.iterate(p, &mut trial, step_t, &mut peak_energy) {
+                    match self.iterate(p, &mut trial, step_t, &mut peak_energy, &mut last_tol) {
                         Ok(h) => {
-                            if restarts < self.settings.max_restarts && p.end_step(&trial, step_t) {
-                                restarts += 1;
-                                summary.newton_iterations += h.len() - 1;
-                                continue;
+                            if p.end_step(&trial, step_t) {
+                                // the problem's own condition (the augmented Lagrangian's penetration
+                                // tolerance) does not hold yet: solve again, but never call the step
+                                // converged while it does not hold
+                                if restarts < self.settings.max_restarts {
+                                    restarts += 1;
+                                    summary.newton_iterations += h.len() - 1;
+                                    continue;
+                                }
+                                let r = h.last().copied().unwrap_or(f64::NAN);
+                                break Err((
+                                    format!("the contact constraints were still violated beyond the penetration tolerance after {} augmented-Lagrangian updates", self.settings.max_restarts),
+                                    r,
+                                    last_tol,
+                                ));
                             }
                             break Ok(h);
                         }

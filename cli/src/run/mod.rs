@@ -8,6 +8,7 @@
 //! * [`plot`]: PNG/SVG line plots (contact pressure, the paper's Figure 4).
 
 pub mod build;
+pub mod memory;
 pub mod mesh;
 pub mod output;
 pub mod plot;
