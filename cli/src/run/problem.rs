@@ -573,11 +573,36 @@ fn toml_message(source: &str, e: &toml::de::Error) -> String {
     let Some(span) = e.span() else { return what };
     let (line, col) = line_col_of(source, span.start);
     let text = source.lines().nth(line - 1).unwrap_or("");
+    let what = match key_at(source, line, col) {
+        Some(key) => format!("{}: {what}", quote(&key)),
+        None => what,
+    };
     // a window of the line around the column
     let skip = col.saturating_sub(40);
     let shown: String = text.chars().skip(skip).collect();
     let shown = format!("{}{}", if skip > 0 { "..." } else { "" }, quote(&shown));
     format!("line {line}, column {col}: {what}\n  {line} | {shown}")
+}
+
+/// The dotted key whose value sits at (line, column), for toml errors, which give only a place:
+/// the last `key =` before the column on that line, after the last `[table]` header above it
+/// ("solver.steps", "mesh.n" inside an inline table). None when the place is not a value.
+fn key_at(source: &str, line: usize, col: usize) -> Option<String> {
+    let text = source.lines().nth(line.checked_sub(1)?)?;
+    let before: String = text.chars().take(col.saturating_sub(1)).collect();
+    let eq = before.rfind('=')?;
+    let key: String = before[..eq].trim_end().chars().rev().take_while(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '"')).collect::<Vec<_>>().into_iter().rev().collect();
+    if key.is_empty() {
+        return None;
+    }
+    let table = source.lines().take(line - 1).filter_map(|l| {
+        let l = l.trim();
+        l.starts_with('[').then(|| l.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string())
+    });
+    Some(match table.last() {
+        Some(t) if !t.is_empty() => format!("{t}.{key}"),
+        _ => key,
+    })
 }
 
 /// [`quote`] with a longer limit (toml's messages list expected keys): control characters become
