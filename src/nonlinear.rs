@@ -560,3 +560,121 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         Ok(summary)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! What Newton calls converged holds, and what it reports is the truth: a one-unknown problem
+    //! R(u, t) = u - t whose residual can be made NaN past a load factor, and whose end_step can
+    //! refuse every converged state (an augmented-Lagrangian tolerance that is never met).
+    use super::*;
+    use crate::linear_solver::SparseLu;
+    use faer::sparse::SymbolicSparseColMatRef;
+
+    struct Line {
+        residual: [f64; 1],
+        col_ptr: [usize; 2],
+        row_idx: [usize; 1],
+        tangent: [f64; 1],
+        /// The residual is NaN for t above this.
+        nan_above: f64,
+        /// end_step asks for another solve every time.
+        never_satisfied: bool,
+        restarts: usize,
+    }
+
+    impl Line {
+        fn new() -> Self {
+            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0 }
+        }
+    }
+
+    impl NonlinearProblem for Line {
+        fn num_dofs(&self) -> usize {
+            1
+        }
+        fn num_equations(&self) -> usize {
+            1
+        }
+        fn apply_prescribed(&self, _u: &mut [f64], _t: f64) {}
+        fn evaluate(&mut self, u: &[f64], t: f64, _with_tangent: bool) -> Result<Evaluation> {
+            self.residual[0] = if t > self.nan_above { f64::NAN } else { u[0] - t };
+            Ok(Evaluation { residual_norm: self.residual[0].abs(), force_scale: 1.0, active_changes: 0 })
+        }
+        fn residual(&self) -> &[f64] {
+            &self.residual
+        }
+        fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
+            SparseColMatRef::new(SymbolicSparseColMatRef::new_checked(1, 1, &self.col_ptr, None, &self.row_idx), &self.tangent)
+        }
+        fn add_increment(&self, u: &mut [f64], du: &[f64]) {
+            u[0] += du[0];
+        }
+        fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
+            self.restarts += 1;
+            self.never_satisfied
+        }
+    }
+
+    fn settings() -> NewtonSettings {
+        NewtonSettings { max_increment: 0.25, max_cutbacks: 2, ..NewtonSettings::default() }
+    }
+
+    #[test]
+    fn settings_without_iterations_or_with_crossed_increments_are_refused() {
+        assert!(settings().validate().is_ok());
+        let e = NewtonSettings { max_iterations: 0, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("max_iterations must be from 1"), "{e}");
+        let e = NewtonSettings { min_increment: 0.5, max_increment: 0.2, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("min_increment 5e-1 exceeds max_increment 2e-1"), "{e}");
+        let e = NewtonSettings { initial_increment: 5e-324, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("initial_increment"), "{e}");
+        // solve_path validates too: no iteration is run
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let r = NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_iterations: 0, ..settings() }).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| {});
+        assert!(r.unwrap_err().to_string().contains("max_iterations"));
+    }
+
+    #[test]
+    fn a_nan_residual_is_reported_as_such_with_the_real_tolerance() {
+        let mut p = Line { nan_above: 0.5, ..Line::new() };
+        let mut u = [0.0];
+        let mut steps = Vec::new();
+        let e = NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |r, _, _| steps.push(r.load_factor)).unwrap_err();
+        assert_eq!(steps, vec![0.25, 0.5]);
+        let msg = e.to_string();
+        assert!(msg.contains("the residual became NaN at iteration 0"), "{msg}");
+        match e {
+            StampError::NoConvergence { tolerance, .. } => {
+                // rel_tol * force scale 1 + abs_tol
+                let want = 1e-10 + 1e-14;
+                assert!((tolerance - want).abs() < 1e-20, "tolerance {tolerance:e}, want {want:e}");
+            }
+            e => panic!("{e}"),
+        }
+        assert!(!msg.contains("tolerance 0.000e0"), "{msg}");
+    }
+
+    #[test]
+    fn a_step_whose_end_condition_never_holds_is_not_converged() {
+        let mut p = Line { never_satisfied: true, ..Line::new() };
+        let mut u = [0.0];
+        let mut converged = 0;
+        let s = NewtonSettings { max_restarts: 3, max_cutbacks: 1, ..settings() };
+        let e = NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| converged += 1).unwrap_err();
+        assert_eq!(converged, 0, "no step may be reported converged");
+        let msg = e.to_string();
+        assert!(msg.contains("still violated") && msg.contains("after 3 augmented-Lagrangian updates"), "{msg}");
+        // two attempts (one cut-back), each with 1 + 3 solves asking end_step
+        assert_eq!(p.restarts, 8);
+    }
+
+    #[test]
+    fn an_ordinary_path_still_converges() {
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let summary = NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
+        assert_eq!(summary.steps, 4);
+        assert!((u[0] - 1.0).abs() < 1e-12);
+    }
+}
