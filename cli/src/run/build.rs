@@ -93,7 +93,7 @@ pub const DEFAULT_MAX_INCREMENT: f64 = 0.25;
 /// A mesh error of the plate elements or the model ("element 3 is inverted ...", "node 7 ...",
 /// 0-based indices) restated with the file and the user's numbers: the gmsh element or node tag,
 /// or the 1-based cell / node of the built-in rectangle.
-fn mesh_error(p: &Problem, mesh: &MeshData, e: StampError) -> StampError {
+pub fn mesh_error(p: &Problem, mesh: &MeshData, e: StampError) -> StampError {
     let StampError::Mesh(msg) = &e else { return e };
     let spec = p.spec.mesh.get_ref();
     let (kind, rest) = match msg.split_once(' ') {

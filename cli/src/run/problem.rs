@@ -208,7 +208,10 @@ impl<'de> Deserialize<'de> for DofSet {
         let word = String::deserialize(d)?;
         match dof_components(&word) {
             Some(components) => Ok(DofSet { word, components }),
-            None => Err(D::Error::custom(format!("unknown displacement or constraint '{}'; expected one of {DOF_WORDS}", quote(&word)))),
+            None => Err(D::Error::custom(format!(
+                "unknown displacement or constraint '{}'; expected one of v1-, v2-, v3-, v1+, v2+, v3+, v1, v2, v3, clamped, simply_supported, symmetry_x1, symmetry_x2",
+                quote(&word)
+            ))),
         }
     }
 }
@@ -569,18 +572,21 @@ pub fn line_col_of(source: &str, offset: usize) -> (usize, usize) {
 /// toml's error as "line L, column C: what is wrong" followed by the offending line, both cut to
 /// fit a message (toml itself would echo a line of any length in full).
 fn toml_message(source: &str, e: &toml::de::Error) -> String {
-    let what = quote_long(e.message().trim(), 240);
+    // serde quotes user text (an unknown key, a bad word) between backticks: cut each at 80
+    let what: Vec<String> = e.message().trim().split('`').enumerate().map(|(i, part)| if i % 2 == 1 { quote(part) } else { part.to_string() }).collect();
+    let what = quote_long(&what.join("`"), 300);
     let Some(span) = e.span() else { return what };
     let (line, col) = line_col_of(source, span.start);
     let text = source.lines().nth(line - 1).unwrap_or("");
     let what = match key_at(source, line, col) {
-        Some(key) => format!("{}: {what}", quote(&key)),
-        None => what,
+        // our own checks may name the key already ("mesh.rectangle.n: ...")
+        Some(key) if !what.starts_with(&key) => format!("{}: {what}", quote(&key)),
+        _ => what,
     };
     // a window of the line around the column
-    let skip = col.saturating_sub(40);
+    let skip = col.saturating_sub(30);
     let shown: String = text.chars().skip(skip).collect();
-    let shown = format!("{}{}", if skip > 0 { "..." } else { "" }, quote(&shown));
+    let shown = format!("{}{}", if skip > 0 { "..." } else { "" }, quote_long(&shown, 60));
     format!("line {line}, column {col}: {what}\n  {line} | {shown}")
 }
 
@@ -590,11 +596,30 @@ fn toml_message(source: &str, e: &toml::de::Error) -> String {
 fn key_at(source: &str, line: usize, col: usize) -> Option<String> {
     let text = source.lines().nth(line.checked_sub(1)?)?;
     let before: String = text.chars().take(col.saturating_sub(1)).collect();
-    let eq = before.rfind('=')?;
-    let key: String = before[..eq].trim_end().chars().rev().take_while(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '"')).collect::<Vec<_>>().into_iter().rev().collect();
-    if key.is_empty() {
+    // walk the line up to the column: `key =` sets the pending key, `{` opens an inline table
+    // under it, `}` closes one (strings are skipped)
+    let (mut stack, mut pending, mut word, mut in_string): (Vec<String>, Option<String>, String, bool) = (Vec::new(), None, String::new(), false);
+    for c in before.chars() {
+        match c {
+            '"' => in_string = !in_string,
+            _ if in_string => {}
+            '=' => pending = Some(std::mem::take(&mut word).trim().trim_matches('"').to_string()).filter(|k| !k.is_empty()),
+            '{' => stack.extend(pending.take()),
+            '}' => {
+                stack.pop();
+                pending = None;
+            }
+            ',' => word.clear(),
+            c if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') => word.push(c),
+            c if c.is_whitespace() => {}
+            _ => word.clear(),
+        }
+    }
+    stack.extend(pending);
+    if stack.is_empty() {
         return None;
     }
+    let key = stack.join(".");
     let table = source.lines().take(line - 1).filter_map(|l| {
         let l = l.trim();
         l.starts_with('[').then(|| l.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string())
