@@ -7,6 +7,7 @@
 
 use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use stamp::error::QUOTE_LIMIT;
 use stamp::{quote, Result, StampError};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -572,9 +573,10 @@ pub fn line_col_of(source: &str, offset: usize) -> (usize, usize) {
 /// toml's error as "line L, column C: what is wrong" followed by the offending line, both cut to
 /// fit a message (toml itself would echo a line of any length in full).
 fn toml_message(source: &str, e: &toml::de::Error) -> String {
-    // serde quotes user text (an unknown key, a bad word) between backticks: cut each at 80
-    let what: Vec<String> = e.message().trim().split('`').enumerate().map(|(i, part)| if i % 2 == 1 { quote(part) } else { part.to_string() }).collect();
-    let what = quote_long(&what.join("`"), 300);
+    // serde quotes user text (an unknown key, a bad string) in full: cut every long word at 80
+    // characters, and the whole at 300
+    let what: Vec<String> = e.message().trim().split(' ').map(|w| if w.chars().count() > QUOTE_LIMIT { quote(w) } else { w.to_string() }).collect();
+    let what = quote_long(&what.join(" "), 300);
     let Some(span) = e.span() else { return what };
     let (line, col) = line_col_of(source, span.start);
     let text = source.lines().nth(line - 1).unwrap_or("");
