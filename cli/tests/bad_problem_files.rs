@@ -116,7 +116,7 @@ fn step_counts_and_rectangle_sizes_out_of_range_are_refused() {
     let e = refused("n_5000", &rect("n = [5000, 5000]"), Some("rectangle"), &["mesh.rectangle.n", "25010001 nodes", "GiB", "coarser mesh"]);
     assert!(start.elapsed() < Duration::from_secs(5), "{e}");
     // extents: finite, increasing, with a finite length, cells distinguishable
-    refused("x_huge", &BASE.replace("x = [0.0, 1.0]", "x = [-1e308, 1e308]"), Some("rectangle"), &["mesh.rectangle.x", "finite length", "[-1e308, 1e308]"]);
+    refused("x_huge", &BASE.replace("x = [0.0, 1.0]", "x = [-1e308, 1e308]"), Some("rectangle"), &["mesh.rectangle.x", "magnitude at most 1e100", "[-1e308, 1e308]"]);
     refused("x_backwards", &BASE.replace("x = [0.0, 1.0]", "x = [1.0, 0.0]"), Some("rectangle"), &["mesh.rectangle.x", "increasing"]);
     refused("y_tiny_cells", &BASE.replace("y = [0.0, 100.0]", "y = [1e6, 1.0000000000001e6]"), Some("rectangle"), &["mesh.rectangle.y", "too small to tell their nodes apart"]);
 }
@@ -144,9 +144,15 @@ fn iteration_counts_and_unreachable_tolerances_are_refused() {
     refused("cycling_huge", &solver("cycling_after = 1000000"), Some("cycling_after ="), &["solver.cycling_after", "from 0 to 1000"]);
     refused("rel_tol_tiny", &solver("rel_tol = 1e-20"), Some("rel_tol ="), &["solver.rel_tol", "1e-15", "1e-20"]);
     refused("abs_tol_nan", &solver("abs_tol = nan"), Some("abs_tol ="), &["solver.abs_tol", "NaN"]);
+    // physical sizes whose squares would overflow or vanish
+    refused("thickness_tiny", &BASE.replace("thickness = 2.0", "thickness = 5e-324"), Some("thickness ="), &["plate.thickness", "from 1e-100 to 1e100", "5e-324"]);
+    refused("young_huge", &BASE.replace("E = 2.0e4", "E = 1e300"), Some("E ="), &["plate.E", "1e300"]);
+    refused("force_huge", &BASE.replace("force = [0.0, 0.0, 0.05]", "force = [0.0, 0.0, -1e308]"), Some("force ="), &["load[0].force", "-1e308"]);
     // a penetration far below the round-off of a 100-long model
     let text = format!("{BASE}{PUNCH}penetration_tolerance = 1e-300\n");
-    refused("penetration_tiny", &text, Some("penetration_tolerance"), &["punch[0].penetration_tolerance", "1e-300", "smallest allowed is 1.0e-10"]);
+    refused("penetration_1e-300", &text, Some("penetration_tolerance"), &["punch[0].penetration_tolerance", "1e-300", "from 1e-100"]);
+    let text = format!("{BASE}{PUNCH}penetration_tolerance = 1e-20\n");
+    refused("penetration_tiny", &text, Some("penetration_tolerance"), &["punch[0].penetration_tolerance", "1e-20", "smallest allowed is 1.0e-10"]);
 }
 
 #[test]
@@ -164,11 +170,11 @@ fn user_strings_are_bounded_and_vectors_show_tiny_values() {
     refused("long_key", &BASE.replace("nu = 0.3", &format!("nu = 0.3\n{} = 1", "k".repeat(100_000))), Some("kkkk"), &["unknown field"]);
     // a direction too small to normalise: its value in {:e}, not [0, 0, 0]
     let text = format!("{BASE}{}", PUNCH.replace("axis = [1.0, 0.0, 0.0]", "axis = [1e-200, 0.0, 0.0]"));
-    refused("tiny_axis", &text, Some("axis ="), &["punch.axis", "1e-200", "too small to normalise"]);
+    refused("tiny_axis", &text, Some("axis ="), &["punch[0].axis", "1e-200", "too small to normalise"]);
     let text = format!("{BASE}{}", PUNCH.replace("axis = [1.0, 0.0, 0.0]", "axis = [0.0, 0.0, 0.0]"));
-    refused("zero_axis", &text, Some("axis ="), &["punch.axis", "non-zero"]);
+    refused("zero_axis", &text, Some("axis ="), &["punch[0].axis", "non-zero"]);
     // an unknown constraint word of any length
-    refused("long_word", &BASE.replace("\"clamped\"", &format!("\"{}\"", "w".repeat(5000))), Some("fix ="), &["boundary.fix", "unknown displacement", "(5000 characters)"]);
+    refused("long_word", &BASE.replace("\"clamped\"", &format!("\"{}\"", "w".repeat(5000))), Some("fix ="), &["boundary[0].fix", "unknown displacement", "(5000 characters)"]);
 }
 
 #[test]

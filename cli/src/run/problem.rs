@@ -49,9 +49,9 @@ macro_rules! checked_number {
     };
 }
 
-checked_number!(Positive, "a positive finite number", |v| v > 0.0);
-checked_number!(NonNegative, "a finite number >= 0", |v| v >= 0.0);
-checked_number!(Finite, "a finite number", |_| true);
+checked_number!(Positive, "a positive number from 1e-100 to 1e100", |v| (limits::MIN_MAGNITUDE..=limits::MAX_MAGNITUDE).contains(&v));
+checked_number!(NonNegative, "a number from 0 to 1e100", |v| (0.0..=limits::MAX_MAGNITUDE).contains(&v));
+checked_number!(Finite, "a finite number of magnitude at most 1e100", |v| v.abs() <= limits::MAX_MAGNITUDE);
 checked_number!(Poisson, "Poisson's ratio in (-1, 0.5)", |v| v > -1.0 && v < 0.5);
 checked_number!(Fraction, "a number in [0, 1)", |v| (0.0..1.0).contains(&v));
 checked_number!(Increment, "a load increment in [1e-12, 1e6]", |v| (limits::MIN_INCREMENT..=limits::MAX_LOAD_FACTOR).contains(&v));
@@ -61,6 +61,11 @@ checked_number!(RelTol, "a relative tolerance in [1e-15, 0.1] (below 1e-15 float
 /// The ranges of the settings: every number read from a problem file is checked against these
 /// before it sizes anything or bounds a loop.
 pub mod limits {
+    /// Largest magnitude of any length, modulus, force or coordinate: squares and products of
+    /// such numbers stay finite.
+    pub const MAX_MAGNITUDE: f64 = 1e100;
+    /// Smallest positive length, modulus or tolerance.
+    pub const MIN_MAGNITUDE: f64 = 1e-100;
     /// Most equal steps (`solver.steps`) and most load increments a path may need at
     /// `max_increment` (path length / max_increment).
     pub const MAX_STEPS: u64 = 100_000;
@@ -118,10 +123,10 @@ pub struct Vec3(pub [f64; 3]);
 impl<'de> Deserialize<'de> for Vec3 {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let v = <[f64; 3]>::deserialize(d)?;
-        if v.iter().all(|x| x.is_finite()) {
+        if v.iter().all(|x| x.is_finite() && x.abs() <= limits::MAX_MAGNITUDE) {
             Ok(Vec3(v))
         } else {
-            Err(D::Error::custom(format!("expected three finite numbers, got {}", vec_text(&v))))
+            Err(D::Error::custom(format!("expected three finite numbers of magnitude at most 1e100, got {}", vec_text(&v))))
         }
     }
 }
@@ -293,8 +298,8 @@ impl RectangleSpec {
         }
         for (key, v, k) in [("x", x, n[0]), ("y", y, n[1])] {
             let extent = v[1] - v[0];
-            if !(v[0].is_finite() && v[1].is_finite() && extent.is_finite() && extent > 0.0) {
-                return Err(format!("mesh.rectangle.{key}: expected an increasing interval of finite numbers with a finite length, got {}", vec_text(&v)));
+            if !(v.iter().all(|c| c.abs() <= limits::MAX_MAGNITUDE) && extent > 0.0) {
+                return Err(format!("mesh.rectangle.{key}: expected an increasing interval of finite numbers (magnitude at most 1e100), got {}", vec_text(&v)));
             }
             // neighbouring nodes must have distinct coordinates with room to spare
             let scale = v[0].abs().max(v[1].abs());
@@ -622,12 +627,18 @@ fn key_at(source: &str, line: usize, col: usize) -> Option<String> {
         return None;
     }
     let key = stack.join(".");
-    let table = source.lines().take(line - 1).filter_map(|l| {
-        let l = l.trim();
-        l.starts_with('[').then(|| l.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string())
-    });
-    Some(match table.last() {
-        Some(t) if !t.is_empty() => format!("{t}.{key}"),
+    // the last header above; an array of tables ([[punch]]) gets its index, as in "punch[1]"
+    let headers: Vec<(bool, String)> = source
+        .lines()
+        .take(line - 1)
+        .filter_map(|l| {
+            let l = l.trim();
+            l.starts_with('[').then(|| (l.starts_with("[["), l.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string()))
+        })
+        .collect();
+    Some(match headers.last() {
+        Some((true, t)) => format!("{t}[{}].{key}", headers.iter().filter(|(a, h)| *a && h == t).count() - 1),
+        Some((false, t)) if !t.is_empty() => format!("{t}.{key}"),
         _ => key,
     })
 }
