@@ -105,11 +105,11 @@ fn solver(keys: &str) -> String {
 #[test]
 fn step_counts_and_rectangle_sizes_out_of_range_are_refused() {
     refused("steps_max", &solver("steps = 9223372036854775807"), Some("steps ="), &["solver.steps", "from 1 to 100000"]);
-    refused("steps_float", &solver("steps = 1e12"), Some("steps ="), &["solver.steps", "floating point"]);
+    refused("steps_float", &solver("steps = 1e12"), Some("steps ="), &["solver.steps", "from 1 to 100000, got the decimal number 1000000000000"]);
     refused("steps_zero", &solver("steps = 0"), Some("steps ="), &["solver.steps", "from 1 to 100000"]);
     let rect = |n: &str| BASE.replace("n = [1, 40]", n);
     refused("n_2e32", &rect("n = [4294967296, 4294967296]"), Some("rectangle"), &["mesh.rectangle.n", "1 to 1000000"]);
-    refused("n_u64max", &rect("n = [18446744073709551615, 1]"), Some("rectangle"), &["rectangle.n", "18446744073709551615"]);
+    refused("n_u64max", &rect("n = [18446744073709551615, 1]"), Some("rectangle"), &["mesh.rectangle.n", "1 to 1000000, got [18446744073709551615, 1]"]);
     refused("n_negative", &rect("n = [-3, 4]"), Some("rectangle"), &["mesh.rectangle.n", "[-3, 4]"]);
     // a model far beyond any machine's memory: refused up front with the estimate, in no time
     let start = Instant::now();
@@ -195,6 +195,12 @@ fn only_regular_files_are_read() {
     let (code, err) = stamp_run(Path::new("/dev/zero"), &dir.join("out"), Duration::from_secs(10));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("/dev/zero") && err.contains("not a regular file"), "{err}");
+    // binary bytes: not UTF-8, with the line
+    let binary = dir.join("binary.toml");
+    std::fs::write(&binary, b"title = \"x\"\n\xff\xfe\x00junk\n").unwrap();
+    let (code, err) = stamp_run(&binary, &dir.join("out"), Duration::from_secs(10));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("binary.toml") && err.contains("line 2") && err.contains("not UTF-8"), "{err}");
     // a file too large for a problem file
     let big = write(&dir, "big.toml", &format!("{BASE}\n#{}\n", "x".repeat(2 << 20)));
     let (code, err) = stamp_run(&big, &dir.join("out"), Duration::from_secs(10));

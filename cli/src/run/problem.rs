@@ -92,6 +92,32 @@ pub mod limits {
     pub const MIN_PENETRATION_TOLERANCE: f64 = 1e-12;
 }
 
+/// Any number as written (a whole number of any size, or a float), for range messages that show
+/// what was given instead of serde's "expected i64".
+struct AnyNumber(std::result::Result<i128, f64>);
+
+impl<'de> Deserialize<'de> for AnyNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = AnyNumber;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a whole number")
+            }
+            fn visit_i64<E>(self, v: i64) -> std::result::Result<AnyNumber, E> {
+                Ok(AnyNumber(Ok(v.into())))
+            }
+            fn visit_u64<E>(self, v: u64) -> std::result::Result<AnyNumber, E> {
+                Ok(AnyNumber(Ok(v.into())))
+            }
+            fn visit_f64<E>(self, v: f64) -> std::result::Result<AnyNumber, E> {
+                Ok(AnyNumber(Err(v)))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 /// A whole number in a range, checked while deserialising (so toml gives the line).
 macro_rules! checked_count {
     ($name:ident, $min:expr, $max:expr) => {
@@ -99,12 +125,11 @@ macro_rules! checked_count {
         pub struct $name(pub usize);
         impl<'de> Deserialize<'de> for $name {
             fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
-                let v = i64::deserialize(d)?;
                 let (min, max): (u64, u64) = ($min, $max);
-                if v >= 0 && (v as u64) >= min && (v as u64) <= max {
-                    Ok($name(v as usize))
-                } else {
-                    Err(D::Error::custom(format!("expected a whole number from {min} to {max}, got {v}")))
+                match AnyNumber::deserialize(d)?.0 {
+                    Ok(v) if v >= min as i128 && v <= max as i128 => Ok($name(v as usize)),
+                    Ok(v) => Err(D::Error::custom(format!("expected a whole number from {min} to {max}, got {v}"))),
+                    Err(v) => Err(D::Error::custom(format!("expected a whole number from {min} to {max}, got the decimal number {}", num(v)))),
                 }
             }
         }
@@ -286,16 +311,21 @@ pub struct RectangleSpec {
 struct RawRectangle {
     x: [f64; 2],
     y: [f64; 2],
-    n: [i64; 2],
+    n: [AnyNumber; 2],
 }
 
 impl RectangleSpec {
     /// What is wrong with these values, if anything.
-    fn check(x: [f64; 2], y: [f64; 2], n: [i64; 2]) -> std::result::Result<[usize; 2], String> {
+    fn check(x: [f64; 2], y: [f64; 2], n: [AnyNumber; 2]) -> std::result::Result<[usize; 2], String> {
         let max = limits::MAX_CELLS_PER_SIDE;
-        if n.iter().any(|&k| k < 1 || k as u64 > max) {
-            return Err(format!("mesh.rectangle.n: expected two whole numbers from 1 to {max}, got [{}, {}]", n[0], n[1]));
-        }
+        let shown = |k: &AnyNumber| match k.0 {
+            Ok(v) => v.to_string(),
+            Err(v) => num(v),
+        };
+        let n = match (&n[0].0, &n[1].0) {
+            (Ok(a), Ok(b)) if (1..=max as i128).contains(a) && (1..=max as i128).contains(b) => [*a as i64, *b as i64],
+            _ => return Err(format!("mesh.rectangle.n: expected two whole numbers from 1 to {max}, got [{}, {}]", shown(&n[0]), shown(&n[1]))),
+        };
         for (key, v, k) in [("x", x, n[0]), ("y", y, n[1])] {
             let extent = v[1] - v[0];
             if !(v.iter().all(|c| c.abs() <= limits::MAX_MAGNITUDE) && extent > 0.0) {
