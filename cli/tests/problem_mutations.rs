@@ -84,6 +84,9 @@ fn floor_char(text: &str, mut i: usize) -> usize {
 /// One random mutation of `text`, and what it did.
 fn mutate(text: &str, rng: &mut Rng, extremes: &[String]) -> (String, String) {
     let lines: Vec<&str> = text.lines().collect();
+    if lines.is_empty() {
+        return (text.to_string(), "nothing (empty text)".into());
+    }
     match rng.below(8) {
         0 | 1 | 2 => {
             let nums = numbers(text);
