@@ -251,11 +251,14 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// Called after every Newton iteration with (iteration, residual norm, force scale): for
     /// progress bars.
     pub on_iteration: Option<Box<dyn FnMut(usize, f64, f64)>>,
+    /// Set (by the step callback, say, after its output failed) to end the path after the current
+    /// step: `solve_path` then returns [`StampError::Problem`] "stopped on request".
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl<L: LinearSolver> NewtonRaphson<L> {
     pub fn new(linear: L, settings: NewtonSettings) -> Self {
-        NewtonRaphson { settings, linear, on_iteration: None }
+        NewtonRaphson { settings, linear, on_iteration: None, stop: None }
     }
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history,
@@ -531,6 +534,10 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             target_index: is_target.then_some(ti),
                         };
                         on_step(&report, u, p);
+                        if self.stop.as_ref().is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed)) {
+                            summary.seconds = start.elapsed().as_secs_f64();
+                            return Err(StampError::Problem(format!("stopped on request after load step {} (load factor {t:.6e})", summary.steps)));
+                        }
                         cutbacks_in_row = 0;
                         if iterations <= self.settings.easy_iterations {
                             dt = (dt * self.settings.growth).min(self.settings.max_increment);
@@ -667,6 +674,27 @@ mod tests {
         assert!(msg.contains("still violated") && msg.contains("after 3 augmented-Lagrangian updates"), "{msg}");
         // two attempts (one cut-back), each with 1 + 3 solves asking end_step
         assert_eq!(p.restarts, 8);
+    }
+
+    #[test]
+    fn a_stop_request_ends_the_path_after_the_step() {
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let mut newton = NewtonRaphson::new(SparseLu::new(), settings());
+        newton.stop = Some(stop.clone());
+        let mut steps = 0;
+        let e = newton
+            .solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |r, _, _| {
+                steps += 1;
+                if r.step == 2 {
+                    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            })
+            .unwrap_err();
+        assert_eq!(steps, 2);
+        assert!(e.to_string().contains("stopped on request after load step 2"), "{e}");
+        assert!((u[0] - 0.5).abs() < 1e-12, "u holds the last converged state: {}", u[0]);
     }
 
     #[test]

@@ -265,6 +265,9 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
     let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
     newton.on_iteration = progress.callback();
+    // a failed output write ends the run after its step (what follows could not be written)
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    newton.stop = Some(stop.clone());
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
@@ -346,13 +349,15 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
                     }
                 }
                 write_error = Some(e);
+                stop.store(true, std::sync::atomic::Ordering::Relaxed);
             }
         }
     });
     progress.finish();
     drop(cx);
     summary.newton_iterations = total_iterations;
-    let solve_failure = result.err();
+    // after a write failure the solve stopped on request: that is no failure of its own
+    let solve_failure = if write_error.is_some() { None } else { result.err() };
     if let Some(e) = &solve_failure {
         let lf = match e {
             StampError::NoConvergence { load_factor, .. } => Some(*load_factor),
