@@ -165,6 +165,47 @@ impl Default for NewtonSettings {
     }
 }
 
+impl NewtonSettings {
+    /// Refuse settings with which a solve cannot work or cannot end: no iterations, increments that
+    /// are not positive finite numbers or in the wrong order, tolerances that are not numbers
+    /// or that floating point cannot reach, loop counts beyond any use.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(StampError::Problem(format!("Newton settings: {m}")));
+        if self.max_iterations == 0 || self.max_iterations > 100_000 {
+            return bad(format!("max_iterations must be from 1 to 100000, got {}", self.max_iterations));
+        }
+        if self.line_search_steps > 1000 || self.max_cutbacks > 1000 || self.max_restarts > 100_000 {
+            return bad(format!(
+                "line_search_steps ({}) and max_cutbacks ({}) must be at most 1000, max_restarts ({}) at most 100000",
+                self.line_search_steps, self.max_cutbacks, self.max_restarts
+            ));
+        }
+        for (name, v) in [("max_increment", self.max_increment), ("initial_increment", self.initial_increment), ("min_increment", self.min_increment)] {
+            if !(v.is_finite() && v >= f64::MIN_POSITIVE) {
+                return bad(format!("{name} must be a positive finite (normal) number, got {v:e}"));
+            }
+        }
+        if self.min_increment > self.max_increment {
+            return bad(format!("min_increment {:e} exceeds max_increment {:e}", self.min_increment, self.max_increment));
+        }
+        if !(self.growth.is_finite() && self.growth >= 1.0) {
+            return bad(format!("growth must be a finite number >= 1, got {:e}", self.growth));
+        }
+        if !(self.rel_tol.is_finite() && self.rel_tol >= 0.0 && self.abs_tol.is_finite() && self.abs_tol >= 0.0 && self.rel_tol + self.abs_tol > 0.0) {
+            return bad(format!("rel_tol ({:e}) and abs_tol ({:e}) must be finite, >= 0 and not both 0", self.rel_tol, self.abs_tol));
+        }
+        if self.rel_tol > 0.0 && self.rel_tol < 1e-16 {
+            return bad(format!("rel_tol {:e} is below round-off; the smallest allowed is 1e-16", self.rel_tol));
+        }
+        for (name, v) in [("floor_tol", self.floor_tol), ("disp_tol", self.disp_tol), ("loose_tol", self.loose_tol), ("energy_tol", self.energy_tol), ("forcing", self.forcing), ("chord_tol", self.chord_tol)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(format!("{name} must be a finite number >= 0, got {v:e}"));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// One converged load step.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct StepReport {
@@ -210,11 +251,14 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// Called after every Newton iteration with (iteration, residual norm, force scale): for
     /// progress bars.
     pub on_iteration: Option<Box<dyn FnMut(usize, f64, f64)>>,
+    /// Set (by the step callback, say, after its output failed) to end the path after the current
+    /// step: `solve_path` then returns [`StampError::Problem`] "stopped on request".
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl<L: LinearSolver> NewtonRaphson<L> {
     pub fn new(linear: L, settings: NewtonSettings) -> Self {
-        NewtonRaphson { settings, linear, on_iteration: None }
+        NewtonRaphson { settings, linear, on_iteration: None, stop: None }
     }
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history,
@@ -222,7 +266,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     /// `peak_energy` is the largest first-correction energy of the path's converged steps:
     /// the energy criterion compares with it too, because a step that starts from a good predictor
     /// has a first correction already at round-off.
-    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
         let s = &self.settings;
         let mut history = Vec::new();
         let mut du = vec![0.0; p.num_equations()];
@@ -245,9 +289,11 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         for it in 0..=s.max_iterations {
             let (ev, with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
-                None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), f64::NAN, 0.0))?, true),
+                None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true),
             };
-            let tol = s.rel_tol * ev.force_scale + s.abs_tol;
+            // the tolerance of this iterate (that of the last one when the force scale is not a number)
+            let tol = if ev.force_scale.is_finite() { s.rel_tol * ev.force_scale + s.abs_tol } else { *last_tol };
+            *last_tol = tol;
             history.push(ev.residual_norm);
             // a chord step may follow a Newton step, or a chord step that reduced |R| a hundredfold
             let chord_allowed = !last_chord || (history.len() > 1 && ev.residual_norm <= 1e-2 * history[history.len() - 2]);
@@ -257,8 +303,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             if let Some(cb) = self.on_iteration.as_mut() {
                 cb(it, ev.residual_norm, ev.force_scale);
             }
-            if !ev.residual_norm.is_finite() {
-                return Err(("the residual is not finite".into(), ev.residual_norm, tol));
+            if !ev.residual_norm.is_finite() || !ev.force_scale.is_finite() {
+                let what = if ev.residual_norm.is_nan() || ev.force_scale.is_nan() { "NaN" } else { "infinite" };
+                return Err((format!("the residual became {what} at iteration {it}"), ev.residual_norm, tol));
             }
             if it == 0 {
                 first = ev.residual_norm.max(tol);
@@ -383,7 +430,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             }
             p.add_increment(u, &du);
         }
-        Err(("no convergence".into(), f64::NAN, 0.0))
+        Err((format!("no convergence in {} iterations", s.max_iterations), history.last().copied().unwrap_or(f64::NAN), *last_tol))
     }
 }
 
@@ -397,7 +444,10 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         on_step: &mut dyn FnMut(&StepReport, &[f64], &P),
     ) -> Result<SolveSummary> {
         let start = Instant::now();
+        self.settings.validate()?;
         p.want_preconditioner(self.linear.uses_preconditioner());
+        // the tolerance of the last evaluation, for an error whose own iterate has none
+        let mut last_tol = self.settings.abs_tol;
         let mut summary = SolveSummary::default();
         let mut t = t0;
         let mut trial = u.to_vec();
@@ -416,6 +466,12 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
             while t != target {
                 let remaining = target - t;
                 let step_t = if dt >= remaining.abs() * (1.0 - 1e-12) { target } else { t + dt.copysign(remaining) };
+                if step_t == t || !step_t.is_finite() {
+                    // an increment below the round-off of t would repeat the same step for ever
+                    return Err(StampError::Problem(format!(
+                        "the load increment {dt:e} does not change the load factor {t:e} (round-off); raise min_increment"
+                    )));
+                }
                 trial.copy_from_slice(u);
                 if let (true, Some((u_prev, t_prev))) = (self.settings.extrapolate, previous.as_ref()) {
                     let ratio = (step_t - t) / (t - t_prev);
@@ -429,12 +485,23 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 p.start_step();
                 let mut restarts = 0;
                 let result = loop {
-                    match self.iterate(p, &mut trial, step_t, &mut peak_energy) {
+                    match self.iterate(p, &mut trial, step_t, &mut peak_energy, &mut last_tol) {
                         Ok(h) => {
-                            if restarts < self.settings.max_restarts && p.end_step(&trial, step_t) {
-                                restarts += 1;
-                                summary.newton_iterations += h.len() - 1;
-                                continue;
+                            if p.end_step(&trial, step_t) {
+                                // the problem's own condition (the augmented Lagrangian's penetration
+                                // tolerance) does not hold yet: solve again, but never call the step
+                                // converged while it does not hold
+                                if restarts < self.settings.max_restarts {
+                                    restarts += 1;
+                                    summary.newton_iterations += h.len() - 1;
+                                    continue;
+                                }
+                                let r = h.last().copied().unwrap_or(f64::NAN);
+                                break Err((
+                                    format!("the contact constraints were still violated beyond the penetration tolerance after {} augmented-Lagrangian updates", self.settings.max_restarts),
+                                    r,
+                                    last_tol,
+                                ));
                             }
                             break Ok(h);
                         }
@@ -467,6 +534,10 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             target_index: is_target.then_some(ti),
                         };
                         on_step(&report, u, p);
+                        if self.stop.as_ref().is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed)) {
+                            summary.seconds = start.elapsed().as_secs_f64();
+                            return Err(StampError::Problem(format!("stopped on request after load step {} (load factor {t:.6e})", summary.steps)));
+                        }
                         cutbacks_in_row = 0;
                         if iterations <= self.settings.easy_iterations {
                             dt = (dt * self.settings.growth).min(self.settings.max_increment);
@@ -494,5 +565,144 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         }
         summary.seconds = start.elapsed().as_secs_f64();
         Ok(summary)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! What Newton calls converged holds, and what it reports is the truth: a one-unknown problem
+    //! R(u, t) = u - t whose residual can be made NaN past a load factor, and whose end_step can
+    //! refuse every converged state (an augmented-Lagrangian tolerance that is never met).
+    use super::*;
+    use crate::linear_solver::SparseLu;
+    use faer::sparse::SymbolicSparseColMatRef;
+
+    struct Line {
+        residual: [f64; 1],
+        col_ptr: [usize; 2],
+        row_idx: [usize; 1],
+        tangent: [f64; 1],
+        /// The residual is NaN for t above this.
+        nan_above: f64,
+        /// end_step asks for another solve every time.
+        never_satisfied: bool,
+        restarts: usize,
+    }
+
+    impl Line {
+        fn new() -> Self {
+            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0 }
+        }
+    }
+
+    impl NonlinearProblem for Line {
+        fn num_dofs(&self) -> usize {
+            1
+        }
+        fn num_equations(&self) -> usize {
+            1
+        }
+        fn apply_prescribed(&self, _u: &mut [f64], _t: f64) {}
+        fn evaluate(&mut self, u: &[f64], t: f64, _with_tangent: bool) -> Result<Evaluation> {
+            self.residual[0] = if t > self.nan_above { f64::NAN } else { u[0] - t };
+            Ok(Evaluation { residual_norm: self.residual[0].abs(), force_scale: 1.0, active_changes: 0 })
+        }
+        fn residual(&self) -> &[f64] {
+            &self.residual
+        }
+        fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
+            SparseColMatRef::new(SymbolicSparseColMatRef::new_checked(1, 1, &self.col_ptr, None, &self.row_idx), &self.tangent)
+        }
+        fn add_increment(&self, u: &mut [f64], du: &[f64]) {
+            u[0] += du[0];
+        }
+        fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
+            self.restarts += 1;
+            self.never_satisfied
+        }
+    }
+
+    fn settings() -> NewtonSettings {
+        NewtonSettings { max_increment: 0.25, max_cutbacks: 2, ..NewtonSettings::default() }
+    }
+
+    #[test]
+    fn settings_without_iterations_or_with_crossed_increments_are_refused() {
+        assert!(settings().validate().is_ok());
+        let e = NewtonSettings { max_iterations: 0, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("max_iterations must be from 1"), "{e}");
+        let e = NewtonSettings { min_increment: 0.5, max_increment: 0.2, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("min_increment 5e-1 exceeds max_increment 2e-1"), "{e}");
+        let e = NewtonSettings { initial_increment: 5e-324, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("initial_increment"), "{e}");
+        // solve_path validates too: no iteration is run
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let r = NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_iterations: 0, ..settings() }).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| {});
+        assert!(r.unwrap_err().to_string().contains("max_iterations"));
+    }
+
+    #[test]
+    fn a_nan_residual_is_reported_as_such_with_the_real_tolerance() {
+        let mut p = Line { nan_above: 0.5, ..Line::new() };
+        let mut u = [0.0];
+        let mut steps = Vec::new();
+        let e = NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |r, _, _| steps.push(r.load_factor)).unwrap_err();
+        assert_eq!(steps, vec![0.25, 0.5]);
+        let msg = e.to_string();
+        assert!(msg.contains("the residual became NaN at iteration 0"), "{msg}");
+        match e {
+            StampError::NoConvergence { tolerance, .. } => {
+                // rel_tol * force scale 1 + abs_tol
+                let want = 1e-10 + 1e-14;
+                assert!((tolerance - want).abs() < 1e-20, "tolerance {tolerance:e}, want {want:e}");
+            }
+            e => panic!("{e}"),
+        }
+        assert!(!msg.contains("tolerance 0.000e0"), "{msg}");
+    }
+
+    #[test]
+    fn a_step_whose_end_condition_never_holds_is_not_converged() {
+        let mut p = Line { never_satisfied: true, ..Line::new() };
+        let mut u = [0.0];
+        let mut converged = 0;
+        let s = NewtonSettings { max_restarts: 3, max_cutbacks: 1, ..settings() };
+        let e = NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| converged += 1).unwrap_err();
+        assert_eq!(converged, 0, "no step may be reported converged");
+        let msg = e.to_string();
+        assert!(msg.contains("still violated") && msg.contains("after 3 augmented-Lagrangian updates"), "{msg}");
+        // two attempts (one cut-back), each with 1 + 3 solves asking end_step
+        assert_eq!(p.restarts, 8);
+    }
+
+    #[test]
+    fn a_stop_request_ends_the_path_after_the_step() {
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let mut newton = NewtonRaphson::new(SparseLu::new(), settings());
+        newton.stop = Some(stop.clone());
+        let mut steps = 0;
+        let e = newton
+            .solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |r, _, _| {
+                steps += 1;
+                if r.step == 2 {
+                    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+            })
+            .unwrap_err();
+        assert_eq!(steps, 2);
+        assert!(e.to_string().contains("stopped on request after load step 2"), "{e}");
+        assert!((u[0] - 0.5).abs() < 1e-12, "u holds the last converged state: {}", u[0]);
+    }
+
+    #[test]
+    fn an_ordinary_path_still_converges() {
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let summary = NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
+        assert_eq!(summary.steps, 4);
+        assert!((u[0] - 1.0).abs() < 1e-12);
     }
 }

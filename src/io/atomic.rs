@@ -13,13 +13,19 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// A temporary path next to `path`: ".<name>.tmp-<pid>-<n>" (hidden, unique within the process).
+/// Characters of the target's name kept in the temporary name: a target whose name is close to
+/// the file system's limit (255 bytes) must not fail because its temporary name is longer.
+const TEMP_NAME_CHARS: usize = 64;
+
+/// A temporary path next to `path`: ".<name>.tmp-<pid>-<n>" (hidden, unique within the process),
+/// with at most [`TEMP_NAME_CHARS`] characters of the name.
 fn temp_path(path: &Path) -> io::Result<PathBuf> {
     let name = path
         .file_name()
         .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the output path has no file name"))?;
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let tmp = format!(".{}.tmp-{}-{}", name.to_string_lossy(), std::process::id(), n);
+    let short: String = name.to_string_lossy().chars().take(TEMP_NAME_CHARS).collect();
+    let tmp = format!(".{short}.tmp-{}-{}", std::process::id(), n);
     Ok(path.with_file_name(tmp))
 }
 
@@ -68,4 +74,26 @@ impl Drop for TempGuard {
 /// Writes a string to `path` atomically (see [`write_atomically`]).
 pub fn write_string_atomically(path: &Path, contents: &str) -> Result<()> {
     write_atomically(path, |w| w.write_all(contents.as_bytes()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_near_the_file_system_limit_is_written() {
+        let dir = std::env::temp_dir().join(format!("stamp-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // 250 bytes: the file fits (255 at most); ".<name>.tmp-<pid>-<n>" would not
+        let path = dir.join("n".repeat(246) + ".csv");
+        write_string_atomically(&path, "x").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "x");
+        // a name beyond the limit fails with an error that names it, and leaves nothing behind
+        let long = dir.join("n".repeat(300));
+        let e = write_string_atomically(&long, "x").unwrap_err().to_string();
+        assert!(e.contains("nnnn"), "{e}");
+        let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(left.len(), 1, "{left:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -87,11 +87,53 @@ fn add_force(model: &mut Model<PlateElements>, node: usize, f: [f64; 3], face: L
     Ok(())
 }
 
+/// The default largest load increment of `stamp run`.
+pub const DEFAULT_MAX_INCREMENT: f64 = 0.25;
+
+/// A mesh error of the plate elements or the model ("element 3 is inverted ...", "node 7 ...",
+/// 0-based indices) restated with the file and the user's numbers: the gmsh element or node tag,
+/// or the 1-based cell / node of the built-in rectangle.
+pub fn mesh_error(p: &Problem, mesh: &MeshData, e: StampError) -> StampError {
+    let StampError::Mesh(msg) = &e else { return e };
+    let spec = p.spec.mesh.get_ref();
+    let (kind, rest) = match msg.split_once(' ') {
+        Some((k @ ("element" | "node"), rest)) => (k, rest),
+        _ => ("", msg.as_str()),
+    };
+    let (index, tail) = match rest.split_once(' ') {
+        Some((i, tail)) if !kind.is_empty() => (i.parse::<usize>().ok(), tail),
+        _ => (None, rest),
+    };
+    let tags = if kind == "element" { mesh.cell_tags.as_ref() } else { mesh.node_tags.as_ref() };
+    match (&spec.file, index) {
+        (Some(file), Some(i)) => {
+            let who = match tags.and_then(|t| t.get(i)) {
+                Some(tag) => format!("gmsh {kind} {tag}"),
+                None => format!("{kind} {}", i + 1),
+            };
+            StampError::Input { file: p.dir().join(file.get_ref()).display().to_string(), message: format!("{who} {tail}") }
+        }
+        (Some(file), None) => StampError::Input { file: p.dir().join(file.get_ref()).display().to_string(), message: msg.clone() },
+        (None, Some(i)) => {
+            let what = if kind == "element" { "cell" } else { "node" };
+            p.error_at(p.spec.mesh.span(), "mesh.rectangle", format!("{what} {} (counted from 1) {tail}", i + 1))
+        }
+        (None, None) => p.error_at(p.spec.mesh.span(), "mesh.rectangle", msg),
+    }
+}
+
 /// Build everything the solve needs.
 pub fn build(p: &Problem) -> Result<Setup> {
     let s = &p.spec;
-    let mesh = MeshData::load(p)?;
+    let mesh = MeshData::load(p).map_err(|e| match e {
+        StampError::Mesh(m) => p.error_at(s.mesh.span(), "mesh", m),
+        e => e,
+    })?;
     let n_nodes = mesh.mesh.num_nodes();
+    // a gmsh mesh is read first (its size bounded by its file); refuse it before the model is built
+    if let Some(file) = &s.mesh.get_ref().file {
+        super::memory::check_model_fits(n_nodes as u64).map_err(|m| p.error_at(file.span(), "mesh.file", m))?;
+    }
 
     // plate
     let ps = s.plate.get_ref();
@@ -105,7 +147,7 @@ pub fn build(p: &Problem) -> Result<Setup> {
         KinematicsSpec::Nonlinear => Kinematics::Nonlinear,
         KinematicsSpec::Linear => Kinematics::Linear,
     };
-    let plate = PlateElements::new(&mesh.mesh, section.clone(), kin)?;
+    let plate = PlateElements::new(&mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?;
 
     // constraints
     let mut dofs = DofMap::new(n_nodes, 6)?;
@@ -129,7 +171,10 @@ pub fn build(p: &Problem) -> Result<Setup> {
             }
         }
     }
-    let mut model = Model::new(plate, dofs).map_err(|e| StampError::Input { file: p.path.display().to_string(), message: e.to_string() })?;
+    let mut model = Model::new(plate, dofs).map_err(|e| match e {
+        e @ StampError::Mesh(_) => mesh_error(p, &mesh, e),
+        e => StampError::Input { file: p.path.display().to_string(), message: e.to_string() },
+    })?;
 
     // loads
     for (i, l) in s.load.iter().enumerate() {
@@ -237,8 +282,19 @@ pub fn build(p: &Problem) -> Result<Setup> {
             pair.drive = Some(ForceDrive::new(dir, f.0).map_err(wrap)?);
         }
         model.add_contact(pair);
-        if let Some(t) = spec.penetration_tolerance {
-            tolerance = Some(tolerance.map_or(t.0, |x: f64| x.min(t.0)));
+        if let Some(t) = &spec.penetration_tolerance {
+            let tol = t.get_ref().0;
+            // below the round-off of the model's size the penetration cannot be measured
+            let size = model_size(&mesh, &section, spec.radius.map(|r| r.0));
+            let floor = super::problem::limits::MIN_PENETRATION_TOLERANCE * size;
+            if tol < floor {
+                return Err(p.error_at(
+                    t.span(),
+                    &format!("{key}.penetration_tolerance"),
+                    format!("{:e} is below the round-off of a model of size {:e}; the smallest allowed is {floor:.1e}", tol, size),
+                ));
+            }
+            tolerance = Some(tolerance.map_or(tol, |x: f64| x.min(tol)));
         }
         punches.push(PunchInfo { name, face, z, surface, eps_reg, eps_automatic });
     }
@@ -246,15 +302,15 @@ pub fn build(p: &Problem) -> Result<Setup> {
 
     // solver
     let sv = &s.solver;
-    let mut settings = NewtonSettings { max_increment: 0.25, ..NewtonSettings::default() };
-    if let Some(x) = sv.max_increment {
-        settings.max_increment = x.0;
+    let mut settings = NewtonSettings { max_increment: DEFAULT_MAX_INCREMENT, ..NewtonSettings::default() };
+    if let Some(x) = &sv.max_increment {
+        settings.max_increment = x.get_ref().0;
     }
     if let Some(x) = sv.initial_increment {
         settings.initial_increment = x.0;
     }
-    if let Some(x) = sv.min_increment {
-        settings.min_increment = x.0;
+    if let Some(x) = &sv.min_increment {
+        settings.min_increment = x.get_ref().0;
     }
     if let Some(x) = sv.rel_tol {
         settings.rel_tol = x.0;
@@ -263,16 +319,24 @@ pub fn build(p: &Problem) -> Result<Setup> {
         settings.abs_tol = x.0;
     }
     if let Some(x) = sv.max_iterations {
-        settings.max_iterations = x;
+        settings.max_iterations = x.0;
     }
     if let Some(x) = sv.max_cutbacks {
-        settings.max_cutbacks = x;
+        settings.max_cutbacks = x.0;
     }
     if let Some(x) = sv.line_search_steps {
-        settings.line_search_steps = x;
+        settings.line_search_steps = x.0;
     }
     if let Some(x) = sv.cycling_after {
-        settings.cycling_after = x;
+        settings.cycling_after = x.0;
     }
+    settings.validate().map_err(|e| StampError::Input { file: p.path.display().to_string(), message: format!("[solver]: {e}") })?;
     Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings })
+}
+
+/// The size of the model as a length: the largest of the coordinates' magnitudes, the face
+/// offsets and the punch radius (the scale of the round-off in a penetration).
+fn model_size(mesh: &MeshData, section: &Section, radius: Option<f64>) -> f64 {
+    let coords = mesh.mesh.coords.iter().flat_map(|x| x.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+    coords.max(section.delta_minus.abs()).max(section.delta_plus.abs()).max(radius.unwrap_or(0.0))
 }

@@ -22,6 +22,8 @@ pub struct MeshData {
     pub surfaces: BTreeMap<String, Vec<usize>>,
     /// gmsh node tags (for the CSV), if read from gmsh.
     pub node_tags: Option<Vec<u64>>,
+    /// gmsh element tag of each cell (for error messages), if read from gmsh.
+    pub cell_tags: Option<Vec<u64>>,
 }
 
 impl MeshData {
@@ -35,7 +37,7 @@ impl MeshData {
             }
             let g = read_msh(&path)?;
             let surfaces = g.mesh.cell_groups.clone();
-            Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), mesh: g.mesh })
+            Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh })
         } else {
             let r = spec.rectangle.as_ref().expect("checked: file or rectangle");
             let (nx, ny) = (r.n[0], r.n[1]);
@@ -66,7 +68,7 @@ impl MeshData {
                 mesh.node_groups.insert(k.clone(), v.clone());
             }
             let surfaces = mesh.cell_groups.clone();
-            Ok(MeshData { mesh, points, curves, surfaces, node_tags: None })
+            Ok(MeshData { mesh, points, curves, surfaces, node_tags: None, cell_tags: None })
         }
     }
 
@@ -170,5 +172,9 @@ impl MeshData {
 /// An error for a group that does not exist or has the wrong dimension.
 pub fn group_error(p: &Problem, span: std::ops::Range<usize>, key: &str, name: &str, want: &str, mesh: &MeshData) -> StampError {
     let want = if want.is_empty() { String::new() } else { format!("{want} ") };
-    p.error_at(span, key, format!("no {want}group named '{name}'; the mesh has: {}", mesh.all_names()))
+    let mut names = mesh.all_names();
+    if names.chars().count() > 200 {
+        names = names.chars().take(200).collect::<String>() + ", ...";
+    }
+    p.error_at(span, key, format!("no {want}group named '{}'; the mesh has: {names}", stamp::quote(name)))
 }

@@ -12,6 +12,7 @@
 
 pub mod build;
 pub mod check;
+pub mod memory;
 pub mod mesh;
 pub mod out_dir;
 pub mod output;

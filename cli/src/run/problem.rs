@@ -7,13 +7,29 @@
 
 use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
-use stamp::{Result, StampError};
+use stamp::error::QUOTE_LIMIT;
+use stamp::{quote, Result, StampError};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 // ---------------------------------------------------------------------------------------------
 // validated numbers: the error is raised inside the deserializer, so toml reports its line
+
+/// A number as a message shows it: plain decimals for ordinary sizes, `{:e}` for tiny or huge ones
+/// (so that 1e300 is not printed with 300 digits and 1e-200 does not show as 0).
+pub fn num(v: f64) -> String {
+    if v == 0.0 || (v.is_finite() && v.abs() >= 1e-4 && v.abs() < 1e15) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A vector as a message shows it (see [`num`]).
+pub fn vec_text(v: &[f64]) -> String {
+    format!("[{}]", v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(", "))
+}
 
 macro_rules! checked_number {
     ($name:ident, $what:expr, $ok:expr) => {
@@ -26,18 +42,105 @@ macro_rules! checked_number {
                 if v.is_finite() && ok(v) {
                     Ok($name(v))
                 } else {
-                    Err(D::Error::custom(format!("expected {}, got {v}", $what)))
+                    Err(D::Error::custom(format!("expected {}, got {}", $what, num(v))))
                 }
             }
         }
     };
 }
 
-checked_number!(Positive, "a positive finite number", |v| v > 0.0);
-checked_number!(NonNegative, "a finite number >= 0", |v| v >= 0.0);
-checked_number!(Finite, "a finite number", |_| true);
+checked_number!(Positive, "a positive number from 1e-100 to 1e100", |v| (limits::MIN_MAGNITUDE..=limits::MAX_MAGNITUDE).contains(&v));
+checked_number!(NonNegative, "a number from 0 to 1e100", |v| (0.0..=limits::MAX_MAGNITUDE).contains(&v));
+checked_number!(Finite, "a finite number of magnitude at most 1e100", |v| v.abs() <= limits::MAX_MAGNITUDE);
 checked_number!(Poisson, "Poisson's ratio in (-1, 0.5)", |v| v > -1.0 && v < 0.5);
 checked_number!(Fraction, "a number in [0, 1)", |v| (0.0..1.0).contains(&v));
+checked_number!(Increment, "a load increment in [1e-12, 1e6]", |v| (limits::MIN_INCREMENT..=limits::MAX_LOAD_FACTOR).contains(&v));
+checked_number!(InitialIncrement, "a fraction of the first target in [1e-12, 1]", |v| (limits::MIN_INCREMENT..=1.0).contains(&v));
+checked_number!(RelTol, "a relative tolerance in [1e-15, 0.1] (below 1e-15 floating point cannot reach it)", |v| (limits::MIN_REL_TOL..=0.1).contains(&v));
+
+/// The ranges of the settings: every number read from a problem file is checked against these
+/// before it sizes anything or bounds a loop.
+pub mod limits {
+    /// Largest magnitude of any length, modulus, force or coordinate: squares and products of
+    /// such numbers stay finite.
+    pub const MAX_MAGNITUDE: f64 = 1e100;
+    /// Smallest positive length, modulus or tolerance.
+    pub const MIN_MAGNITUDE: f64 = 1e-100;
+    /// Most equal steps (`solver.steps`) and most load increments a path may need at
+    /// `max_increment` (path length / max_increment).
+    pub const MAX_STEPS: u64 = 100_000;
+    /// Largest load factor of a target.
+    pub const MAX_LOAD_FACTOR: f64 = 1e6;
+    /// Smallest load increment (max_increment, min_increment, initial_increment).
+    pub const MIN_INCREMENT: f64 = 1e-12;
+    /// Smallest relative tolerance: a residual below 1e-15 of the forces is round-off.
+    pub const MIN_REL_TOL: f64 = 1e-15;
+    /// Newton iterations per step.
+    pub const MAX_ITERATIONS: u64 = 1000;
+    /// Line-search halvings (0.5^60 is below any meaningful step).
+    pub const MAX_LINE_SEARCH_STEPS: u64 = 60;
+    /// Cut-backs in a row (2^-100 of any increment is below MIN_INCREMENT).
+    pub const MAX_CUTBACKS: u64 = 100;
+    /// Cells along one side of the built-in rectangle.
+    pub const MAX_CELLS_PER_SIDE: u64 = 1_000_000;
+    /// Characters of a punch name (it names output files).
+    pub const MAX_NAME_CHARS: usize = 64;
+    /// Bytes of a problem file.
+    pub const MAX_FILE_BYTES: u64 = 1 << 20;
+    /// Smallest penetration tolerance relative to the model size (largest coordinate, thickness
+    /// or punch radius): below it the penetration is round-off.
+    pub const MIN_PENETRATION_TOLERANCE: f64 = 1e-12;
+}
+
+/// Any number as written (a whole number of any size, or a float), for range messages that show
+/// what was given instead of serde's "expected i64".
+struct AnyNumber(std::result::Result<i128, f64>);
+
+impl<'de> Deserialize<'de> for AnyNumber {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = AnyNumber;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a whole number")
+            }
+            fn visit_i64<E>(self, v: i64) -> std::result::Result<AnyNumber, E> {
+                Ok(AnyNumber(Ok(v.into())))
+            }
+            fn visit_u64<E>(self, v: u64) -> std::result::Result<AnyNumber, E> {
+                Ok(AnyNumber(Ok(v.into())))
+            }
+            fn visit_f64<E>(self, v: f64) -> std::result::Result<AnyNumber, E> {
+                Ok(AnyNumber(Err(v)))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// A whole number in a range, checked while deserialising (so toml gives the line).
+macro_rules! checked_count {
+    ($name:ident, $min:expr, $max:expr) => {
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub struct $name(pub usize);
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+                let (min, max): (u64, u64) = ($min, $max);
+                match AnyNumber::deserialize(d)?.0 {
+                    Ok(v) if v >= min as i128 && v <= max as i128 => Ok($name(v as usize)),
+                    Ok(v) => Err(D::Error::custom(format!("expected a whole number from {min} to {max}, got {v}"))),
+                    Err(v) => Err(D::Error::custom(format!("expected a whole number from {min} to {max}, got the decimal number {}", num(v)))),
+                }
+            }
+        }
+    };
+}
+
+checked_count!(StepCount, 1, limits::MAX_STEPS);
+checked_count!(IterationCount, 1, limits::MAX_ITERATIONS);
+checked_count!(CycleCount, 0, limits::MAX_ITERATIONS);
+checked_count!(LineSearchCount, 0, limits::MAX_LINE_SEARCH_STEPS);
+checked_count!(CutbackCount, 0, limits::MAX_CUTBACKS);
 
 /// A 3-vector of finite numbers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,10 +148,10 @@ pub struct Vec3(pub [f64; 3]);
 impl<'de> Deserialize<'de> for Vec3 {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let v = <[f64; 3]>::deserialize(d)?;
-        if v.iter().all(|x| x.is_finite()) {
+        if v.iter().all(|x| x.is_finite() && x.abs() <= limits::MAX_MAGNITUDE) {
             Ok(Vec3(v))
         } else {
-            Err(D::Error::custom(format!("expected three finite numbers, got {v:?}")))
+            Err(D::Error::custom(format!("expected three finite numbers of magnitude at most 1e100, got {}", vec_text(&v))))
         }
     }
 }
@@ -59,10 +162,14 @@ pub struct Direction(pub [f64; 3]);
 impl<'de> Deserialize<'de> for Direction {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let v = Vec3::deserialize(d)?.0;
-        if v.iter().map(|x| x * x).sum::<f64>() > 0.0 {
-            Ok(Direction(v))
-        } else {
+        // the squares must stay normal numbers, or normalising loses accuracy (or divides by 0)
+        let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if largest == 0.0 {
             Err(D::Error::custom("expected a non-zero direction, got [0, 0, 0]"))
+        } else if largest < 1e-150 {
+            Err(D::Error::custom(format!("the direction [{}] is too small to normalise accurately (its largest component must be at least 1e-150)", v.map(|x| format!("{x:e}")).join(", "))))
+        } else {
+            Ok(Direction(v))
         }
     }
 }
@@ -74,16 +181,22 @@ pub struct Targets(pub Vec<f64>);
 impl<'de> Deserialize<'de> for Targets {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let v = Vec::<f64>::deserialize(d)?;
+        if v.len() as u64 > limits::MAX_STEPS {
+            return Err(D::Error::custom(format!("at most {} load factors, got {}", limits::MAX_STEPS, v.len())));
+        }
         if v.is_empty() {
             return Err(D::Error::custom("expected at least one load factor"));
         }
         let mut last = 0.0;
         for &t in &v {
             if !(t.is_finite() && t >= 0.0) {
-                return Err(D::Error::custom(format!("load factors must be finite and >= 0, got {t}")));
+                return Err(D::Error::custom(format!("load factors must be finite and >= 0, got {}", num(t))));
+            }
+            if t > limits::MAX_LOAD_FACTOR {
+                return Err(D::Error::custom(format!("load factors must be at most {:e}, got {}", limits::MAX_LOAD_FACTOR, num(t))));
             }
             if t == last {
-                return Err(D::Error::custom(format!("each load factor must differ from the one before (the path starts at 0): {t} after {last}")));
+                return Err(D::Error::custom(format!("each load factor must differ from the one before (the path starts at 0): {} after {}", num(t), num(last))));
             }
             last = t;
         }
@@ -126,7 +239,10 @@ impl<'de> Deserialize<'de> for DofSet {
         let word = String::deserialize(d)?;
         match dof_components(&word) {
             Some(components) => Ok(DofSet { word, components }),
-            None => Err(D::Error::custom(format!("unknown displacement or constraint '{word}'; expected one of {DOF_WORDS}"))),
+            None => Err(D::Error::custom(format!(
+                "unknown displacement or constraint '{}'; expected one of v1-, v2-, v3-, v1+, v2+, v3+, v1, v2, v3, clamped, simply_supported, symmetry_x1, symmetry_x2",
+                quote(&word)
+            ))),
         }
     }
 }
@@ -140,7 +256,7 @@ impl<'de> Deserialize<'de> for DofKey {
         let word = String::deserialize(d)?;
         match word.as_str() {
             "v1-" | "v2-" | "v3-" | "v1+" | "v2+" | "v3+" | "v1" | "v2" | "v3" => Ok(DofKey(word)),
-            _ => Err(D::Error::custom(format!("'{word}' cannot be prescribed; expected one of v1-, v2-, v3-, v1+, v2+, v3+, v1, v2, v3"))),
+            _ => Err(D::Error::custom(format!("'{}' cannot be prescribed; expected one of v1-, v2-, v3-, v1+, v2+, v3+, v1, v2, v3", quote(&word)))),
         }
     }
 }
@@ -180,12 +296,60 @@ pub struct MeshSpec {
     pub rectangle: Option<RectangleSpec>,
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// The built-in rectangle, checked while deserialising: finite increasing intervals with a finite
+/// extent, cells large enough for distinct node coordinates, and a node count (checked
+/// arithmetic) whose model fits in memory ([`super::memory`]).
+#[derive(Debug)]
 pub struct RectangleSpec {
     pub x: [f64; 2],
     pub y: [f64; 2],
     pub n: [usize; 2],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRectangle {
+    x: [f64; 2],
+    y: [f64; 2],
+    n: [AnyNumber; 2],
+}
+
+impl RectangleSpec {
+    /// What is wrong with these values, if anything.
+    fn check(x: [f64; 2], y: [f64; 2], n: [AnyNumber; 2]) -> std::result::Result<[usize; 2], String> {
+        let max = limits::MAX_CELLS_PER_SIDE;
+        let shown = |k: &AnyNumber| match k.0 {
+            Ok(v) => v.to_string(),
+            Err(v) => num(v),
+        };
+        let n = match (&n[0].0, &n[1].0) {
+            (Ok(a), Ok(b)) if (1..=max as i128).contains(a) && (1..=max as i128).contains(b) => [*a as i64, *b as i64],
+            _ => return Err(format!("mesh.rectangle.n: expected two whole numbers from 1 to {max}, got [{}, {}]", shown(&n[0]), shown(&n[1]))),
+        };
+        for (key, v, k) in [("x", x, n[0]), ("y", y, n[1])] {
+            let extent = v[1] - v[0];
+            if !(v.iter().all(|c| c.abs() <= limits::MAX_MAGNITUDE) && extent > 0.0) {
+                return Err(format!("mesh.rectangle.{key}: expected an increasing interval of finite numbers (magnitude at most 1e100), got {}", vec_text(&v)));
+            }
+            // neighbouring nodes must have distinct coordinates with room to spare
+            let scale = v[0].abs().max(v[1].abs());
+            if extent / (k as f64) < 1e-9 * scale || extent / (k as f64) < 1e-150 {
+                return Err(format!("mesh.rectangle.{key}: {} cells across {} are too small to tell their nodes apart (cell size {} against coordinates up to {})", k, vec_text(&v), num(extent / k as f64), num(scale)));
+            }
+        }
+        let (nx, ny) = (n[0] as u64, n[1] as u64);
+        let nodes = (nx + 1).checked_mul(ny + 1).ok_or_else(|| format!("mesh.rectangle.n: [{nx}, {ny}] gives more nodes than this machine can count"))?;
+        super::memory::check_model_fits(nodes).map_err(|e| format!("mesh.rectangle.n: [{nx}, {ny}]: {e}"))?;
+        Ok([nx as usize, ny as usize])
+    }
+}
+
+impl<'de> Deserialize<'de> for RectangleSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let r = RawRectangle::deserialize(d)?;
+        let n = RectangleSpec::check(r.x, r.y, r.n).map_err(D::Error::custom)?;
+        Ok(RectangleSpec { x: r.x, y: r.y, n })
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -334,7 +498,7 @@ pub struct PunchSpec {
     pub eps_reg: Option<Positive>,
     /// Augmented-Lagrangian penetration tolerance (a length).
     #[serde(default)]
-    pub penetration_tolerance: Option<Positive>,
+    pub penetration_tolerance: Option<Spanned<Positive>>,
     /// Default: exact for a nonlinear plate, shallow (along x3) for a linear one.
     #[serde(default)]
     pub kinematics: Option<ContactKinematicsSpec>,
@@ -348,27 +512,27 @@ pub struct SolverSpec {
     pub targets: Option<Spanned<Targets>>,
     /// ... or this many equal steps to load factor 1.
     #[serde(default)]
-    pub steps: Option<Spanned<usize>>,
+    pub steps: Option<Spanned<StepCount>>,
     #[serde(default)]
-    pub max_increment: Option<Positive>,
+    pub max_increment: Option<Spanned<Increment>>,
     #[serde(default)]
-    pub initial_increment: Option<Positive>,
+    pub initial_increment: Option<InitialIncrement>,
     #[serde(default)]
-    pub min_increment: Option<Positive>,
+    pub min_increment: Option<Spanned<Increment>>,
     #[serde(default)]
-    pub rel_tol: Option<Positive>,
+    pub rel_tol: Option<RelTol>,
     #[serde(default)]
     pub abs_tol: Option<NonNegative>,
     #[serde(default)]
-    pub max_iterations: Option<usize>,
+    pub max_iterations: Option<IterationCount>,
     #[serde(default)]
-    pub max_cutbacks: Option<usize>,
+    pub max_cutbacks: Option<CutbackCount>,
     #[serde(default)]
-    pub line_search_steps: Option<usize>,
+    pub line_search_steps: Option<LineSearchCount>,
     /// Give up a step whose active set swings at every iteration without progress from this
     /// iteration on, and cut it back (off by default; see NewtonSettings::cycling_after).
     #[serde(default)]
-    pub cycling_after: Option<usize>,
+    pub cycling_after: Option<CycleCount>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -429,6 +593,97 @@ impl Default for OutputSpec {
 
 // ---------------------------------------------------------------------------------------------
 
+/// "line L, column C" (1-based; the column counts characters) of a byte offset of `source`.
+pub fn line_col_of(source: &str, offset: usize) -> (usize, usize) {
+    let mut offset = offset.min(source.len());
+    while !source.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &source[..offset];
+    let line = before.matches('\n').count() + 1;
+    let col = before[before.rfind('\n').map(|i| i + 1).unwrap_or(0)..].chars().count() + 1;
+    (line, col)
+}
+
+/// toml's error as "line L, column C: what is wrong" followed by the offending line, both cut to
+/// fit a message (toml itself would echo a line of any length in full).
+fn toml_message(source: &str, e: &toml::de::Error) -> String {
+    // serde quotes user text (an unknown key, a bad string) in full: cut every long word at 80
+    // characters, and the whole at 300
+    let what: Vec<String> = e.message().trim().split(' ').map(|w| if w.chars().count() > QUOTE_LIMIT { quote(w) } else { w.to_string() }).collect();
+    let what = quote_long(&what.join(" "), 300);
+    let Some(span) = e.span() else { return what };
+    let (line, col) = line_col_of(source, span.start);
+    let text = source.lines().nth(line - 1).unwrap_or("");
+    let what = match key_at(source, line, col) {
+        // our own checks may name the key already ("mesh.rectangle.n: ...")
+        Some(key) if !what.starts_with(&key) => format!("{}: {what}", quote(&key)),
+        _ => what,
+    };
+    // a window of the line around the column
+    let skip = col.saturating_sub(30);
+    let shown: String = text.chars().skip(skip).collect();
+    let shown = format!("{}{}", if skip > 0 { "..." } else { "" }, quote_long(&shown, 60));
+    format!("line {line}, column {col}: {what}\n  {line} | {shown}")
+}
+
+/// The dotted key whose value sits at (line, column), for toml errors, which give only a place:
+/// the last `key =` before the column on that line, after the last `[table]` header above it
+/// ("solver.steps", "mesh.n" inside an inline table). None when the place is not a value.
+fn key_at(source: &str, line: usize, col: usize) -> Option<String> {
+    let text = source.lines().nth(line.checked_sub(1)?)?;
+    let before: String = text.chars().take(col.saturating_sub(1)).collect();
+    // walk the line up to the column: `key =` sets the pending key, `{` opens an inline table
+    // under it, `}` closes one (strings are skipped)
+    let (mut stack, mut pending, mut word, mut in_string): (Vec<String>, Option<String>, String, bool) = (Vec::new(), None, String::new(), false);
+    for c in before.chars() {
+        match c {
+            '"' => in_string = !in_string,
+            _ if in_string => {}
+            '=' => pending = Some(std::mem::take(&mut word).trim().trim_matches('"').to_string()).filter(|k| !k.is_empty()),
+            '{' => stack.extend(pending.take()),
+            '}' => {
+                stack.pop();
+                pending = None;
+            }
+            ',' => word.clear(),
+            c if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') => word.push(c),
+            c if c.is_whitespace() => {}
+            _ => word.clear(),
+        }
+    }
+    stack.extend(pending);
+    if stack.is_empty() {
+        return None;
+    }
+    let key = stack.join(".");
+    // the last header above; an array of tables ([[punch]]) gets its index, as in "punch[1]"
+    let headers: Vec<(bool, String)> = source
+        .lines()
+        .take(line - 1)
+        .filter_map(|l| {
+            let l = l.trim();
+            l.starts_with('[').then(|| (l.starts_with("[["), l.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string()))
+        })
+        .collect();
+    Some(match headers.last() {
+        Some((true, t)) => format!("{t}[{}].{key}", headers.iter().filter(|(a, h)| *a && h == t).count() - 1),
+        Some((false, t)) if !t.is_empty() => format!("{t}.{key}"),
+        _ => key,
+    })
+}
+
+/// [`quote`] with a longer limit (toml's messages list expected keys): control characters become
+/// '?', the text is cut at `limit` characters.
+fn quote_long(text: &str, limit: usize) -> String {
+    let total = text.chars().count();
+    let mut out: String = text.chars().take(limit).map(|c| if c.is_control() { '?' } else { c }).collect();
+    if total > limit {
+        out.push_str(&format!("... ({total} characters)"));
+    }
+    out
+}
+
 /// A parsed problem with its file name and source text (for line numbers).
 #[derive(Debug)]
 pub struct Problem {
@@ -439,17 +694,36 @@ pub struct Problem {
 
 impl Problem {
     /// Read and parse a problem file.
+    /// Only a regular file of at most [`limits::MAX_FILE_BYTES`] is read: a FIFO, a device or a
+    /// folder is refused from its metadata, before it is opened (opening a FIFO blocks).
     pub fn read(path: &Path) -> Result<Problem> {
-        let source = std::fs::read_to_string(path).map_err(|e| StampError::io(path, e))?;
+        let meta = std::fs::metadata(path).map_err(|e| StampError::io(path, e))?;
+        let input = |message: String| StampError::Input { file: path.display().to_string(), message };
+        if !meta.is_file() {
+            let kind = if meta.is_dir() { "a folder" } else { "not a regular file (a FIFO, socket or device)" };
+            return Err(input(format!("is {kind}; a problem file must be a regular file")));
+        }
+        if meta.len() > limits::MAX_FILE_BYTES {
+            return Err(input(format!("is {} bytes long; a problem file has at most {} bytes", meta.len(), limits::MAX_FILE_BYTES)));
+        }
+        let mut bytes = Vec::new();
+        let file = std::fs::File::open(path).map_err(|e| StampError::io(path, e))?;
+        // the file may have grown since: read no more than the limit allows
+        std::io::Read::read_to_end(&mut std::io::Read::take(file, limits::MAX_FILE_BYTES + 1), &mut bytes).map_err(|e| StampError::io(path, e))?;
+        if bytes.len() as u64 > limits::MAX_FILE_BYTES {
+            return Err(input(format!("has more than {} bytes; a problem file has at most that many", limits::MAX_FILE_BYTES)));
+        }
+        let source = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            let (line, _) = line_col_of(&String::from_utf8_lossy(&e.as_bytes()[..at]), at);
+            input(format!("line {line}: not UTF-8 text (byte {at})"))
+        })?;
         Problem::parse(path, source)
     }
 
     /// Parse problem text (`path` names it in errors and anchors relative paths).
     pub fn parse(path: &Path, source: String) -> Result<Problem> {
-        let spec: ProblemFile = toml::from_str(&source).map_err(|e| StampError::Input {
-            file: path.display().to_string(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let spec: ProblemFile = toml::from_str(&source).map_err(|e| StampError::Input { file: path.display().to_string(), message: toml_message(&source, &e) })?;
         let p = Problem { path: path.to_path_buf(), source, spec };
         p.check()?;
         Ok(p)
@@ -457,10 +731,7 @@ impl Problem {
 
     /// "line L, column C" of a byte offset.
     pub fn line_col(&self, offset: usize) -> (usize, usize) {
-        let before = &self.source[..offset.min(self.source.len())];
-        let line = before.matches('\n').count() + 1;
-        let col = before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
-        (line, col)
+        line_col_of(&self.source, offset)
     }
 
     /// An input error located at `span`, naming `key`.
@@ -553,27 +824,62 @@ impl Problem {
                 return Err(self.error_at(p.span(), &format!("{key}.direction"), "`direction` is the direction of `force`; it needs `force`"));
             }
             let name = self.punch_name(i);
-            if !names.insert(name.clone()) {
-                return Err(self.error_at(p.span(), &format!("{key}.name"), format!("two punches are named '{name}'")));
+            if name.is_empty() || name.chars().count() > limits::MAX_NAME_CHARS || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+                return Err(self.error_at(
+                    p.span(),
+                    &format!("{key}.name"),
+                    format!("'{}' must be 1 to {} letters, digits, '_' or '-' (it names files)", quote(&name), limits::MAX_NAME_CHARS),
+                ));
             }
-            if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-                return Err(self.error_at(p.span(), &format!("{key}.name"), format!("'{name}' must be non-empty letters, digits, '_' or '-' (it names files)")));
+            if !names.insert(name.clone()) {
+                return Err(self.error_at(p.span(), &format!("{key}.name"), format!("two punches are named '{}'", quote(&name))));
             }
         }
         if s.solver.targets.is_some() && s.solver.steps.is_some() {
             let t = s.solver.targets.as_ref().unwrap();
             return Err(self.error_at(t.span(), "solver.targets", "give `targets` or `steps`, not both"));
         }
-        if let Some(n) = &s.solver.steps {
-            if *n.get_ref() == 0 {
-                return Err(self.error_at(n.span(), "solver.steps", "must be at least 1"));
-            }
-        }
+        self.check_increments()?;
         if s.output.plot_axis == PlotAxis::Arc && s.output.plot_group.is_none() {
             return Err(StampError::Input {
                 file: self.path.display().to_string(),
                 message: "output.plot_axis = \"arc\" needs output.plot_group (a curve group)".into(),
             });
+        }
+        Ok(())
+    }
+
+    /// The load increments against the path: min_increment <= max_increment, at most
+    /// [`limits::MAX_STEPS`] increments of max_increment along the path, and a min_increment above
+    /// the round-off of the largest load factor (so that every increment moves the load).
+    fn check_increments(&self) -> Result<()> {
+        let sv = &self.spec.solver;
+        let defaults = stamp::nonlinear::NewtonSettings::default();
+        let max_inc = sv.max_increment.as_ref().map_or(super::build::DEFAULT_MAX_INCREMENT, |x| x.get_ref().0);
+        let min_inc = sv.min_increment.as_ref().map_or(defaults.min_increment, |x| x.get_ref().0);
+        // where to point: the key given, else the [solver] targets/steps, else the file
+        let span_of = |k: &Option<Spanned<Increment>>| k.as_ref().map(|x| x.span()).or_else(|| sv.targets.as_ref().map(|t| t.span())).or_else(|| sv.steps.as_ref().map(|t| t.span()));
+        let fail = |span: Option<std::ops::Range<usize>>, key: &str, message: String| match span {
+            Some(sp) => self.error_at(sp, key, message),
+            None => StampError::Input { file: self.path.display().to_string(), message: format!("{key}: {message}") },
+        };
+        if min_inc > max_inc {
+            return Err(fail(span_of(&sv.min_increment), "solver.min_increment", format!("{} exceeds max_increment = {}", num(min_inc), num(max_inc))));
+        }
+        let targets = self.targets();
+        let path: f64 = targets.iter().fold((0.0, 0.0), |(len, last): (f64, f64), &t| (len + (t - last).abs(), t)).0;
+        let increments = path / max_inc;
+        if increments > limits::MAX_STEPS as f64 {
+            return Err(fail(
+                span_of(&sv.max_increment),
+                "solver.max_increment",
+                format!("the load path (length {}) needs {} increments of max_increment = {}; at most {} are allowed: raise max_increment or shorten the targets", num(path), num(increments.ceil()), num(max_inc), limits::MAX_STEPS),
+            ));
+        }
+        let largest = targets.iter().cloned().fold(1.0, f64::max);
+        let floor = 1e-12 * largest;
+        if min_inc < floor {
+            return Err(fail(span_of(&sv.min_increment), "solver.min_increment", format!("{} is below the round-off of load factors up to {}; the smallest allowed is {}", num(min_inc), num(largest), num(floor))));
         }
         Ok(())
     }
@@ -588,7 +894,7 @@ impl Problem {
         if let Some(t) = &self.spec.solver.targets {
             t.get_ref().0.clone()
         } else if let Some(n) = &self.spec.solver.steps {
-            let n = *n.get_ref();
+            let n = n.get_ref().0;
             (1..=n).map(|k| k as f64 / n as f64).collect()
         } else {
             vec![1.0]

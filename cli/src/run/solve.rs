@@ -45,9 +45,13 @@ struct PunchMeta {
 struct Summary {
     problem: String,
     title: Option<String>,
-    /// "running" while the solve goes on, then "converged" or "failed".
+    /// "running" while the solve goes on, then "converged" or "failed" (any error, a failed write
+    /// of an output file included). A "running" summary whose `pid` no longer runs was killed.
     status: String,
     error: Option<String>,
+    /// The process that writes this folder, and when it started (RFC 3339, UTC).
+    pid: u32,
+    started: String,
     nodes: usize,
     cells: usize,
     equations: usize,
@@ -61,8 +65,47 @@ struct Summary {
     seconds: f64,
     point_arrays: Vec<String>,
     cell_arrays: Vec<String>,
-    /// One entry per converged load step; a failure adds a last entry with converged = false.
+    /// One entry per converged load step whose files were all written (the .pvd lists the same
+    /// steps); a Newton failure adds a last entry with converged = false.
     steps: Vec<serde_json::Value>,
+}
+
+/// `time` as RFC 3339 in UTC to the second ("2026-11-24T17:48:33Z").
+pub fn rfc3339_utc(time: std::time::SystemTime) -> String {
+    let secs = time.duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0) as i64;
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    // civil date from days since 1970-01-01 (H. Hinnant's algorithm)
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem % 3600 / 60, rem % 60)
+}
+
+/// Write summary.json; an error says that it was summary.json that could not be written, and
+/// what had gone wrong before (`earlier`), if anything.
+fn write_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>) -> Result<()> {
+    let text = serde_json::to_string_pretty(summary).map_err(json_err)?;
+    write_string_atomically(path, &text).map_err(|e| {
+        let kind = match &e {
+            StampError::Io { source, .. } => source.kind(),
+            _ => std::io::ErrorKind::Other,
+        };
+        let cause = match &e {
+            StampError::Io { source, .. } => source.to_string(),
+            e => e.to_string(),
+        };
+        let message = match earlier {
+            Some(first) => format!("cannot write summary.json ({cause}) after the run failed: {first}"),
+            None => format!("cannot write summary.json: {cause}"),
+        };
+        StampError::Io { path: path.display().to_string(), source: std::io::Error::new(kind, message) }
+    })
 }
 
 /// The progress bar: the load path along the bar, Newton iteration and residual in the message.
@@ -176,6 +219,8 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
         title: p.spec.title.clone(),
         status: "running".into(),
         error: None,
+        pid: std::process::id(),
+        started: rfc3339_utc(std::time::SystemTime::now()),
         nodes: mesh.mesh.num_nodes(),
         cells: mesh.mesh.num_cells(),
         equations: model.dofs.num_equations(),
@@ -214,12 +259,17 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     let mut plot_data: Vec<Vec<Series>> = punches.iter().map(|_| Vec::new()).collect();
     let mut write_error: Option<StampError> = None;
     let mut total_iterations = 0;
+    // a reader sees "running" (with our pid) from the start
+    write_summary(&summary_path, &summary, None)?;
 
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
     // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
     let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
     newton.on_iteration = progress.callback();
+    // a failed output write ends the run after its step (what follows could not be written)
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    newton.stop = Some(stop.clone());
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
@@ -234,15 +284,16 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
             return;
         }
         let mut data = step_data(&cx, m, u, t, path_len, rep);
-        let step_result: Result<()> = (|| {
+        // the step's files first; only when all of them are written is the step listed (.pvd and
+        // summary.json), and a step that failed half-way leaves no file behind
+        let mut written: Vec<PathBuf> = Vec::new();
+        let mut step_plots: Vec<(usize, Series)> = Vec::new();
+        let step_files: Result<()> = (|| {
             if out.vtu {
                 let name = format!("{stem}_{:04}.vtu", rep.step);
                 let path = out_dir.join(&name);
                 write_vtu(&path, &mesh.mesh, &data.point_fields, &data.cell_fields)?;
-                files.push(path);
-                // the .pvd time is the path length: it increases when the load goes down again
-                pvd.push((path_len, name.clone()));
-                write_pvd(&pvd_path, &pvd)?;
+                written.push(path);
                 data.entry.vtu = Some(name);
             }
             for (k, info) in punches.iter().enumerate() {
@@ -256,52 +307,78 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
                     let name = format!("pressure_{}_{:04}.csv", info.name, rep.step);
                     let path = out_dir.join(&name);
                     write_string_atomically(&path, &contact_csv(&rows))?;
-                    files.push(path);
+                    written.push(path);
                     data.entry.csv.push(name);
                 }
                 if out.plot {
                     let pts: Vec<(f64, f64)> = rows.iter().filter_map(|r| axis[r.node].map(|s| (s, r.q_n))).collect();
-                    plot_data[k].push(Series { label: format!("t = {t:.4}"), points: pts });
+                    step_plots.push((k, Series { label: format!("t = {t:.4}"), points: pts }));
                 }
             }
+            if let Some(name) = &data.entry.vtu {
+                // the .pvd time is the path length: it increases when the load goes down again
+                pvd.push((path_len, name.clone()));
+                if let Err(e) = write_pvd(&pvd_path, &pvd) {
+                    pvd.pop();
+                    return Err(e);
+                }
+            }
+            Ok(())
+        })();
+        let mut listed = false;
+        let step_result = step_files.and_then(|()| {
             summary.steps.push(serde_json::to_value(&data.entry).map_err(json_err)?);
+            listed = true;
             summary.newton_iterations = total_iterations;
             summary.seconds = start.elapsed().as_secs_f64();
-            write_string_atomically(&summary_path, &serde_json::to_string_pretty(&summary).map_err(json_err)?)
-        })();
-        if let Err(e) = step_result {
-            write_error = Some(e);
+            // a failed write here is retried at the end (with the failure)
+            write_summary(&summary_path, &summary, None)
+        });
+        match step_result {
+            Ok(()) => {
+                files.append(&mut written);
+                for (k, series) in step_plots {
+                    plot_data[k].push(series);
+                }
+            }
+            Err(e) => {
+                if listed {
+                    // listed in summary.json, which is rewritten at the end: the files stay
+                    files.append(&mut written);
+                } else {
+                    for f in &written {
+                        let _ = std::fs::remove_file(f);
+                    }
+                }
+                write_error = Some(e);
+                stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
         }
     });
     progress.finish();
     drop(cx);
-    if let Some(e) = write_error {
-        return Err(e);
-    }
     summary.newton_iterations = total_iterations;
-    summary.seconds = start.elapsed().as_secs_f64();
-    let failure = result.err();
-    match &failure {
-        None => summary.status = "converged".into(),
-        Some(e) => {
-            summary.status = "failed".into();
-            summary.error = Some(e.to_string());
-            let lf = match e {
-                StampError::NoConvergence { load_factor, .. } => Some(*load_factor),
-                _ => None,
-            };
-            summary.steps.push(serde_json::json!({
-                "load_factor": lf,
-                "converged": false,
-                "error": e.to_string(),
-            }));
-        }
+    // after a write failure the solve stopped on request: that is no failure of its own
+    let solve_failure = if write_error.is_some() { None } else { result.err() };
+    if let Some(e) = &solve_failure {
+        let lf = match e {
+            StampError::NoConvergence { load_factor, .. } => Some(*load_factor),
+            _ => None,
+        };
+        summary.steps.push(serde_json::json!({
+            "load_factor": lf,
+            "converged": false,
+            "error": e.to_string(),
+        }));
     }
-    write_string_atomically(&summary_path, &serde_json::to_string_pretty(&summary).map_err(json_err)?)?;
-    files.push(summary_path.clone());
+    // the first error decides the status: a write failure stopped the outputs, a solve failure the
+    // run; the .pvd and the plots are written either way (they list the written steps)
+    let mut failure: Option<StampError> = write_error.or(solve_failure);
     if out.vtu {
-        write_pvd(&pvd_path, &pvd)?;
-        files.push(pvd_path);
+        match write_pvd(&pvd_path, &pvd) {
+            Ok(()) => files.push(pvd_path),
+            Err(e) => failure = failure.or(Some(e)),
+        }
     }
     if out.plot {
         for (k, info) in punches.iter().enumerate() {
@@ -314,9 +391,22 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
             }
             let title = format!("contact pressure under '{}'", info.name);
             let plot = Plot { title: &title, x_label: &axis_label, y_label: "contact pressure q_n", series: &series };
-            files.extend(write_plot(&out_dir.join(format!("pressure_{}", info.name)), &plot)?);
+            match write_plot(&out_dir.join(format!("pressure_{}", info.name)), &plot) {
+                Ok(f) => files.extend(f),
+                Err(e) => failure = failure.or(Some(e)),
+            }
         }
     }
+    summary.seconds = start.elapsed().as_secs_f64();
+    match &failure {
+        None => summary.status = "converged".into(),
+        Some(e) => {
+            summary.status = "failed".into();
+            summary.error = Some(e.to_string());
+        }
+    }
+    write_summary(&summary_path, &summary, failure.as_ref())?;
+    files.push(summary_path.clone());
     let converged_steps = summary.steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).count();
     match failure {
         Some(e) => Err(e),
