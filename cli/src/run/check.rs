@@ -152,7 +152,7 @@ fn check_groups(p: &Problem, mesh: &MeshData) -> Result<()> {
 
 /// The penetration tolerance of punch `i`: its own, or [`DEFAULT_PENETRATION`] h.
 fn penetration_tolerance(p: &Problem, setup: &Setup, i: usize) -> f64 {
-    p.spec.punch[i].get_ref().penetration_tolerance.map(|t| t.0).unwrap_or(DEFAULT_PENETRATION * setup.section.thickness())
+    p.spec.punch[i].get_ref().penetration_tolerance.as_ref().map(|t| t.get_ref().0).unwrap_or(DEFAULT_PENETRATION * setup.section.thickness())
 }
 
 /// Where punch `i` starts; Err when it starts inside the plate.
@@ -180,7 +180,7 @@ fn punch_start(p: &Problem, setup: &Setup, i: usize, size: f64) -> Result<PunchS
             ));
         }
     }
-    let touch = (TOUCH * size).max(p.spec.punch[i].get_ref().penetration_tolerance.map(|t| t.0).unwrap_or(0.0));
+    let touch = (TOUCH * size).max(p.spec.punch[i].get_ref().penetration_tolerance.as_ref().map(|t| t.get_ref().0).unwrap_or(0.0));
     let mut holding: Vec<PointGap> = gaps.iter().filter(|g| g.gap <= touch).copied().collect();
     let touching = !holding.is_empty();
     if !touching && pair.drive.is_some() {
