@@ -85,20 +85,22 @@ pub fn mid_displacement(u: &[f64], n: usize) -> [f64; 3] {
 pub struct History {
     pub punch_names: Vec<String>,
     pub punch_faces: Vec<Face>,
-    /// Force-driven punches: the force at load factor 1 (labels of the probe plots).
-    pub punch_forces: Vec<Option<f64>>,
+    /// Whether a punch's steps are labelled by force (force driven, or not moving) rather than by
+    /// travel in the probe plots.
+    pub label_by_force: Vec<bool>,
     /// Named point groups (name, nodes).
     pub points: Vec<(String, Vec<usize>)>,
     pub rows: Vec<HistoryRow>,
 }
 
 impl History {
-    /// An empty history; point groups whose name starts with '#' (unnamed gmsh groups) are left out.
-    pub fn new(punches: &[(String, Face, Option<f64>)], point_groups: &[(String, Vec<usize>)]) -> History {
+    /// An empty history for the punches (name, face, label by force); point groups whose name starts
+    /// with '#' (unnamed gmsh groups) are left out.
+    pub fn new(punches: &[(String, Face, bool)], point_groups: &[(String, Vec<usize>)]) -> History {
         History {
             punch_names: punches.iter().map(|p| p.0.clone()).collect(),
             punch_faces: punches.iter().map(|p| p.1).collect(),
-            punch_forces: punches.iter().map(|p| p.2).collect(),
+            label_by_force: punches.iter().map(|p| p.2).collect(),
             points: point_groups.iter().filter(|(k, _)| !k.starts_with('#')).cloned().collect(),
             rows: Vec::new(),
         }
@@ -162,10 +164,10 @@ impl History {
     }
 
     /// The label of a step in the probe plots: the force of the first punch when it is force
-    /// driven, else its travel; the load factor without punches.
+    /// driven or does not move, else its travel; the load factor without punches.
     pub fn step_label(&self, row: &HistoryRow, units: &Units) -> String {
-        match (row.punches.first(), self.punch_forces.first()) {
-            (Some(p), Some(Some(_))) => format!("force {}", units.force_value(&sig4(p.force))),
+        match (row.punches.first(), self.label_by_force.first()) {
+            (Some(p), Some(true)) => format!("force {}", units.force_value(&sig4(p.force))),
             (Some(p), _) => format!("travel {}", units.length_value(&sig4(p.travel))),
             _ => format!("load factor {}", sig4(row.load_factor)),
         }

@@ -20,8 +20,8 @@
 //!
 //! With no probe, a punch and `plot = true`, a default probe named `<punch>` crosses the whole mesh
 //! along x1 (or along `plot_axis` when the file gives it; "arc" means x1) through the first contact
-//! point: the node of largest pressure in the first written step, or, when nothing touches yet, the
-//! node closest to the punch.
+//! point: the active node of the first written step closest to the pressure-weighted centre of its
+//! active nodes, or, when nothing touches yet, the node closest to the punch.
 
 use super::history::{mid_displacement, History, HistoryRow};
 use super::mesh::MeshData;
@@ -349,7 +349,17 @@ impl<'a> Probes<'a> {
         let pick = |key: &dyn Fn(usize) -> f64| (0..pair.points.len()).min_by(|&a, &b| key(a).partial_cmp(&key(b)).unwrap_or(std::cmp::Ordering::Equal));
         let any_active = pair.state.iter().any(|s| s.active);
         let k = if any_active {
-            pick(&|k| if pair.state[k].active { -q[k] } else { f64::INFINITY })
+            // the active node closest to the pressure-weighted centre of the active nodes
+            let (mut c, mut wsum) = ([0.0; 2], 0.0);
+            for (pt, (st, &qk)) in pair.points.iter().zip(pair.state.iter().zip(&q)) {
+                if st.active {
+                    let w = qk.max(0.0) + 1e-300;
+                    c = [c[0] + w * pt.x_ref[0], c[1] + w * pt.x_ref[1]];
+                    wsum += w;
+                }
+            }
+            let c = [c[0] / wsum, c[1] / wsum];
+            pick(&|k| if pair.state[k].active { (pair.points[k].x_ref[0] - c[0]).hypot(pair.points[k].x_ref[1] - c[1]) } else { f64::INFINITY })
         } else {
             pick(&|k| {
                 let s = &pair.state[k];

@@ -171,7 +171,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     }
     let units = Units::new(p.spec.units.as_ref());
     let punch_names: Vec<String> = punches.iter().map(|i| i.name.clone()).collect();
-    let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.map(|f| f.force))).collect();
+    let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.is_some() || c.motion == [0.0; 3])).collect();
     let mut history = History::new(&punch_keys, &point_groups);
     let mut probes = Probes::new(p, &mesh, &out.probe, &punch_names)?;
 

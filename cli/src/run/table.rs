@@ -55,7 +55,7 @@ mod tests {
 
     #[test]
     fn one_row_per_step_with_units_in_the_header() {
-        let mut h = History::new(&[("sphere".into(), Face::Top, Some(500.0))], &[]);
+        let mut h = History::new(&[("sphere".into(), Face::Top, true)], &[]);
         for (k, t) in [0.5, 1.0].iter().enumerate() {
             h.rows.push(HistoryRow {
                 step: k + 1,
