@@ -225,3 +225,26 @@ fn bad_probes_and_units_name_the_file_line_and_key() {
         assert!(err.contains("sphere-ss.toml") && err.contains("line ") && err.contains(key) && err.contains(what), "{name}: {err}");
     }
 }
+
+#[test]
+fn after_a_failure_the_table_history_and_plots_hold_what_converged() {
+    let dir = temp_dir("outputs-failure");
+    // the first target converges in 3 iterations; a jump to 250 times the force in at most 6
+    // iterations without cut-back cannot
+    let problem = variant(&dir, "sphere-ss", &[("steps = 5", "targets = [0.2, 50.0]"), ("max_increment = 0.2", "max_increment = 100.0\nmax_iterations = 6\nmax_cutbacks = 0")], None);
+    let out = dir.join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("run").arg(&problem).arg("--out").arg(&out).output().unwrap();
+    let (stdout, stderr) = (String::from_utf8(o.stdout).unwrap(), String::from_utf8(o.stderr).unwrap());
+    assert!(!o.status.success() && stderr.contains("did not converge"), "{stderr}");
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let done: Vec<&Value> = s["steps"].as_array().unwrap().iter().filter(|e| e["converged"] == true).collect();
+    assert_eq!(done.len(), 1, "{s}");
+    let (_, hist) = read_csv(&out.join("history.csv"));
+    assert_eq!(hist.len(), 1);
+    assert!(close(hist[0][4], -f(&done[0]["punches"]["sphere"]["reaction"][2]), 1e-14, 0.0));
+    let row = stdout.lines().find(|l| l.trim_start().starts_with("1 ")).unwrap_or_else(|| panic!("no table row:\n{stdout}"));
+    assert!(close(row.split_whitespace().nth(3).unwrap().parse().unwrap(), hist[0][4], 5e-6, 0.0), "{row}");
+    for name in ["force_travel_sphere.png", "force_travel_sphere.svg", "probe_sphere.png"] {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+}

@@ -66,7 +66,7 @@ pub fn punch_row(pair: &ContactPair, face: Face, u: &[f64], t: f64) -> PunchRow 
     let d = punch_direction(pair, face);
     let travel = pair.drive_displacement(u).unwrap_or_else(|| dot(pair.punch_displacement(u, t), d));
     let q = pair.pressures();
-    let contact_area = pair.points.iter().zip(&pair.state).filter(|(_, s)| s.active).map(|(p, _)| p.weight).sum();
+    let contact_area = pair.points.iter().zip(&pair.state).filter(|(_, s)| s.active).fold(0.0, |a, (p, _)| a + p.weight);
     PunchRow {
         travel,
         force: dot(pair.reaction(), d),

@@ -104,12 +104,11 @@ impl Progress {
     /// `forces`: the punches' forces and travels, appended to the terse line.
     fn step(&self, step: usize, t: f64, path: f64, iterations: usize, active: usize, penetration: f64, forces: &str) {
         *self.state.lock().unwrap() = (step, t);
-        let msg = format!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact, max penetration {penetration:.2e}");
         if let Some(b) = &self.bar {
             b.set_position(((path / self.path_end) * 1000.0).round().clamp(0.0, 1000.0) as u64);
-            b.set_message(msg);
+            b.set_message(format!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact, max penetration {penetration:.2e}"));
         } else if self.terse {
-            eprintln!("{msg}{forces}");
+            eprintln!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact{forces}, max penetration {penetration:.2e}");
         }
     }
 
