@@ -173,15 +173,21 @@ impl History {
         }
     }
 
-    /// Draw force against travel for every punch: `force_travel_<punch>.png` and `.svg`.
+    /// Draw force against travel for every punch: `force_travel_<punch>.png` and `.svg` (against the
+    /// load factor for a punch whose travel stays 0: a fixed punch).
     pub fn plot_force_travel(&self, dir: &Path, units: &Units) -> Result<Vec<PathBuf>> {
         let mut files = Vec::new();
         for (k, name) in self.punch_names.iter().enumerate() {
+            // a punch that does not move: force against the load factor
+            let fixed = self.rows.iter().all(|r| r.punches[k].travel == 0.0);
             let mut points = vec![(0.0, 0.0)];
-            points.extend(self.rows.iter().map(|r| (r.punches[k].travel, r.punches[k].force)));
+            points.extend(self.rows.iter().map(|r| (if fixed { r.load_factor } else { r.punches[k].travel }, r.punches[k].force)));
             let series = [Series { label: String::new(), points: points.clone(), markers: points }];
-            let title = format!("punch '{name}': force against travel");
-            let x = Units::label("travel", &units.length);
+            let (title, x) = if fixed {
+                (format!("punch '{name}' (fixed): force against load factor"), "load factor".to_string())
+            } else {
+                (format!("punch '{name}': force against travel"), Units::label("travel", &units.length))
+            };
             let y = Units::label("force", &units.force);
             let plot = Plot { title: &title, x_label: &x, y_label: &y, series: &series };
             files.extend(write_plot(&dir.join(format!("force_travel_{name}")), &plot)?);

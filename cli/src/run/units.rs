@@ -76,9 +76,9 @@ impl Units {
         if self.force_given { format!("{x} {}", self.force) } else { x.to_string() }
     }
 
-    /// "name (unit)", the label of an axis or a column.
+    /// "name (unit)", the label of an axis or a column ("force", not "force (force)", without units).
     pub fn label(name: &str, unit: &str) -> String {
-        format!("{name} ({unit})")
+        if name == unit { name.to_string() } else { format!("{name} ({unit})") }
     }
 }
 
