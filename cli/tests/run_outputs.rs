@@ -212,6 +212,7 @@ fn bad_probes_and_units_name_the_file_line_and_key() {
         ("length", "[[output.probe]]\nname = \"a\"\nfrom = [1.0, 2.0]\nto = [1.0, 2.0]\n\n[output]", "output.probe[0].to", "no length"),
         ("name", "[[output.probe]]\nname = \"a b\"\nfrom = [0.0, 0.0]\nto = [1.0, 0.0]\n\n[output]", "output.probe[0].name", "names files"),
         ("twice", "[[output.probe]]\nname = \"a\"\nfrom = [0.0, 0.0]\nto = [1.0, 0.0]\n\n[[output.probe]]\nname = \"a\"\nfrom = [0.0, 0.0]\nto = [2.0, 0.0]\n\n[output]", "output.probe[1].name", "two probes"),
+        ("outside", "[[output.probe]]\nname = \"a\"\nfrom = [30.0, 0.0]\nto = [40.0, 5.0]\n\n[output]", "output.probe[0]", "does not cross the mesh"),
         ("unit", "[units]\nlength = \"\"\n\n[output]", "length", "unit name"),
         ("unknown", "[units]\nmass = \"kg\"\n\n[output]", "mass", "unknown field"),
     ];

@@ -323,13 +323,15 @@ impl<'a> Probes<'a> {
     /// The probes the problem names, or the default probe (see the module notes).
     pub fn new(p: &Problem, mesh: &'a MeshData, probes: &[Spanned<ProbeSpec>], punch_names: &[String]) -> Result<Probes<'a>> {
         let locator = CellLocator::new(&mesh.mesh);
-        let lines: Vec<ProbeLine> = probes
-            .iter()
-            .map(|s| {
-                let s = s.get_ref();
-                ProbeLine::new(&s.name, s.from, s.to, s.points.unwrap_or(DEFAULT_POINTS), &mesh.mesh, &locator)
-            })
-            .collect();
+        let mut lines: Vec<ProbeLine> = Vec::with_capacity(probes.len());
+        for (i, spanned) in probes.iter().enumerate() {
+            let s = spanned.get_ref();
+            let line = ProbeLine::new(&s.name, s.from, s.to, s.points.unwrap_or(DEFAULT_POINTS), &mesh.mesh, &locator);
+            if line.samples.is_empty() {
+                return Err(p.error_at(spanned.span(), &format!("output.probe[{i}]"), format!("the line from {:?} to {:?} does not cross the mesh", s.from, s.to)));
+            }
+            lines.push(line);
+        }
         let pending = (lines.is_empty() && p.spec.output.plot && !punch_names.is_empty()).then(|| DefaultProbe {
             name: punch_names[0].clone(),
             axis: if plot_axis_given(p) && p.spec.output.plot_axis == super::problem::PlotAxis::X2 { 1 } else { 0 },
