@@ -102,6 +102,7 @@ impl Progress {
     }
 
     /// `forces`: the punches' forces and travels, appended to the terse line.
+    #[allow(clippy::too_many_arguments)]
     fn step(&self, step: usize, t: f64, path: f64, iterations: usize, active: usize, penetration: f64, forces: &str) {
         *self.state.lock().unwrap() = (step, t);
         if let Some(b) = &self.bar {

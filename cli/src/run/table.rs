@@ -6,17 +6,30 @@
 use super::history::{sig, History};
 use super::units::Units;
 
+/// One number of a punch's row.
+type Quantity = fn(&super::history::PunchRow) -> f64;
+
+/// One column: the punch's name over its first column (else empty), the header, the values.
+struct Column {
+    group: String,
+    header: String,
+    values: Vec<String>,
+}
+
+fn column(group: String, header: impl Into<String>, values: Vec<String>) -> Column {
+    Column { group, header: header.into(), values }
+}
+
 /// The table text (ends with a newline; empty when no step converged).
 pub fn render(h: &History, units: &Units) -> String {
     if h.rows.is_empty() {
         return String::new();
     }
-    // columns: (group, header, values)
-    let mut cols: Vec<(String, String, Vec<String>)> = Vec::new();
-    cols.push((String::new(), "step".into(), h.rows.iter().map(|r| r.step.to_string()).collect()));
-    cols.push((String::new(), "load factor".into(), h.rows.iter().map(|r| sig(r.load_factor)).collect()));
+    let mut cols: Vec<Column> = Vec::new();
+    cols.push(column(String::new(), "step", h.rows.iter().map(|r| r.step.to_string()).collect()));
+    cols.push(column(String::new(), "load factor", h.rows.iter().map(|r| sig(r.load_factor)).collect()));
     for (k, name) in h.punch_names.iter().enumerate() {
-        let quantities: [(String, fn(&super::history::PunchRow) -> f64); 5] = [
+        let quantities: [(String, Quantity); 5] = [
             (Units::label("travel", &units.length), |p| p.travel),
             (Units::label("force", &units.force), |p| p.force),
             (Units::label("contact area", &units.area), |p| p.contact_area),
@@ -25,22 +38,22 @@ pub fn render(h: &History, units: &Units) -> String {
         ];
         for (i, (header, get)) in quantities.into_iter().enumerate() {
             let group = if i == 0 { format!("{name}:") } else { String::new() };
-            cols.push((group, header, h.rows.iter().map(|r| sig(get(&r.punches[k]))).collect()));
+            cols.push(column(group, header, h.rows.iter().map(|r| sig(get(&r.punches[k]))).collect()));
         }
     }
-    cols.push((String::new(), "Newton".into(), h.rows.iter().map(|r| r.newton_iterations.to_string()).collect()));
-    let widths: Vec<usize> = cols.iter().map(|(g, head, v)| v.iter().map(|s| s.len()).chain([head.chars().count(), g.chars().count()]).max().unwrap_or(0)).collect();
+    cols.push(column(String::new(), "Newton", h.rows.iter().map(|r| r.newton_iterations.to_string()).collect()));
+    let widths: Vec<usize> = cols.iter().map(|c| c.values.iter().map(|s| s.len()).chain([c.header.chars().count(), c.group.chars().count()]).max().unwrap_or(0)).collect();
     let mut out = String::new();
-    if cols.iter().any(|c| !c.0.is_empty()) {
-        let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:<w$}", c.0)).collect();
+    if cols.iter().any(|c| !c.group.is_empty()) {
+        let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:<w$}", c.group)).collect();
         out.push_str(line.join("  ").trim_end());
         out.push('\n');
     }
-    let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:>w$}", c.1)).collect();
+    let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:>w$}", c.header)).collect();
     out.push_str(&line.join("  "));
     out.push('\n');
     for i in 0..h.rows.len() {
-        let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:>w$}", c.2[i])).collect();
+        let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:>w$}", c.values[i])).collect();
         out.push_str(&line.join("  "));
         out.push('\n');
     }
