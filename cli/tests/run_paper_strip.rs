@@ -74,11 +74,11 @@ fn paper_r100_reproduces_table2_last_row() {
             assert_eq!(f[6], 0.0, "{line}");
         }
     }
-    for f in ["pressure_cylinder.png", "pressure_cylinder.svg"] {
+    for f in ["probe_cylinder.png", "probe_cylinder.svg", "force_travel_cylinder.png"] {
         let bytes = std::fs::read(out.join(f)).unwrap();
         assert!(bytes.len() > 1000, "{f} is too small");
     }
-    assert_eq!(&std::fs::read(out.join("pressure_cylinder.png")).unwrap()[..4], b"\x89PNG");
+    assert_eq!(&std::fs::read(out.join("probe_cylinder.png")).unwrap()[..4], b"\x89PNG");
     // no temporary files left behind (the run's manifest of its files is not one)
     for entry in std::fs::read_dir(&out).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();

@@ -42,7 +42,7 @@ fn sphere_demo_presses_the_plate_symmetrically() {
     for w in steps.windows(2) {
         assert!(f(&w[1]["reaction"][2]) < f(&w[0]["reaction"][2]));
     }
-    for name in ["pressure_sphere.png", "pressure_sphere.svg", "sphere-demo.pvd"] {
+    for name in ["probe_sphere.png", "probe_sphere.svg", "force_travel_sphere.png", "history.csv", "sphere-demo.pvd"] {
         assert!(out.join(name).is_file(), "{name}");
     }
 }

@@ -12,15 +12,19 @@
 
 pub mod build;
 pub mod check;
+pub mod history;
 pub mod memory;
 pub mod mesh;
 pub mod out_dir;
 pub mod output;
 pub mod plot;
+pub mod probe;
 pub mod problem;
 pub mod punch_start;
 pub mod rigid_modes;
 pub mod solve;
+pub mod table;
+pub mod units;
 
 pub use problem::Problem;
 pub use solve::{default_out_dir, RunOutcome};
@@ -105,7 +109,7 @@ pub fn plot_paper_figure4(dir: &Path) -> stamp::Result<()> {
             csv.push_str(&format!("{pt},{:e},{:e},{:e},{:e},{:e},{:e}\n", res.load_per_end, res.x2[k], res.deformed[k][0], res.deformed[k][1], q, scale * q));
             pts.push((res.deformed[k][0], scale * q));
         }
-        series.push(Series { label: format!("P~ = {pt}"), points: pts });
+        series.push(Series { label: format!("P~ = {pt}"), points: pts, markers: Vec::new() });
     }
     write_string_atomically(&dir.join("figure4.csv"), &csv)?;
     let plot = Plot {

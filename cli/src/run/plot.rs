@@ -24,6 +24,8 @@ fn register_font() {
 pub struct Series {
     pub label: String,
     pub points: Vec<(f64, f64)>,
+    /// Points drawn as markers (e.g. where the data are nodal values); may be empty.
+    pub markers: Vec<(f64, f64)>,
 }
 
 /// A plot description.
@@ -32,6 +34,23 @@ pub struct Plot<'a> {
     pub x_label: &'a str,
     pub y_label: &'a str,
     pub series: &'a [Series],
+}
+
+/// Okabe & Ito's colour-blind-safe palette without its yellow (unreadable on white), then grey.
+pub const PALETTE: [RGBColor; 8] = [
+    RGBColor(0, 114, 178),   // blue
+    RGBColor(213, 94, 0),    // vermillion
+    RGBColor(0, 158, 115),   // bluish green
+    RGBColor(204, 121, 167), // reddish purple
+    RGBColor(86, 180, 233),  // sky blue
+    RGBColor(230, 159, 0),   // orange
+    RGBColor(0, 0, 0),       // black
+    RGBColor(128, 128, 128), // grey
+];
+
+/// The colour of curve `k`.
+pub fn colour(k: usize) -> RGBColor {
+    PALETTE[k % PALETTE.len()]
 }
 
 fn plot_err(path: &Path, e: impl std::fmt::Display) -> StampError {
@@ -55,48 +74,68 @@ fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+const WIDTH: u32 = 1000;
+const HEIGHT: u32 = 620;
+const LABEL_FONT: u32 = 16;
+
+/// Width of the legend column to the right of the axes (0 without labels): the legend never covers
+/// a curve.
+fn legend_width(p: &Plot) -> u32 {
+    let longest = p.series.iter().map(|s| s.label.chars().count()).max().unwrap_or(0);
+    if longest == 0 {
+        0
+    } else {
+        (longest as u32 * 9 + 60).min(WIDTH / 3)
+    }
+}
+
 fn draw<DB: DrawingBackend>(root: DrawingArea<DB, plotters::coord::Shift>, p: &Plot) -> std::result::Result<(), String>
 where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let (x0, x1) = range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)));
-    let (mut y0, y1) = range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.1)));
+    let area = root.titled(p.title, (FONT_NAME, 22)).map_err(|e| e.to_string())?;
+    let lw = legend_width(p);
+    let (plot_area, legend_area) = area.split_horizontally(WIDTH - lw);
+    let (x0, x1) = range(p.series.iter().flat_map(|s| s.points.iter().chain(&s.markers).map(|q| q.0)));
+    let (mut y0, mut y1) = range(p.series.iter().flat_map(|s| s.points.iter().chain(&s.markers).map(|q| q.1)));
     if y0 > 0.0 {
         y0 = 0.0;
     }
-    let mut chart = ChartBuilder::on(&root)
-        .caption(p.title, (FONT_NAME, 22))
+    if y1 < 0.0 {
+        y1 = 0.0;
+    }
+    let mut chart = ChartBuilder::on(&plot_area)
         .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()
         .x_desc(p.x_label)
         .y_desc(p.y_label)
-        .label_style((FONT_NAME, 15))
-        .axis_desc_style((FONT_NAME, 17))
+        .light_line_style(RGBColor(235, 235, 235))
+        .label_style((FONT_NAME, LABEL_FONT))
+        .axis_desc_style((FONT_NAME, 18))
         .draw()
         .map_err(|e| e.to_string())?;
     for (k, s) in p.series.iter().enumerate() {
-        let color = Palette99::pick(k).to_rgba();
-        chart
-            .draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(2)))
-            .map_err(|e| e.to_string())?
-            .label(s.label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+        let color = colour(k);
+        chart.draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(2))).map_err(|e| e.to_string())?;
+        chart.draw_series(s.markers.iter().map(|&q| Circle::new(q, 4, color.filled()))).map_err(|e| e.to_string())?;
     }
-    if p.series.len() > 1 || p.series.iter().any(|s| !s.label.is_empty()) {
-        chart
-            .configure_series_labels()
-            .label_font((FONT_NAME, 15))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| e.to_string())?;
+    if lw > 0 {
+        let font = (FONT_NAME, LABEL_FONT).into_font().color(&BLACK);
+        for (k, s) in p.series.iter().enumerate() {
+            let y = 30 + 26 * k as i32;
+            let color = colour(k);
+            legend_area.draw(&PathElement::new(vec![(8, y), (38, y)], color.stroke_width(2))).map_err(|e| e.to_string())?;
+            if !s.markers.is_empty() {
+                legend_area.draw(&Circle::new((23, y), 4, color.filled())).map_err(|e| e.to_string())?;
+            }
+            legend_area.draw(&Text::new(s.label.clone(), (46, y - 8), font.clone())).map_err(|e| e.to_string())?;
+        }
     }
     root.present().map_err(|e| e.to_string())?;
     Ok(())
@@ -109,12 +148,12 @@ pub fn write_plot(stem: &Path, p: &Plot) -> Result<[PathBuf; 2]> {
     let svg = stem.with_extension("svg");
     // SVG into a string, written atomically
     let mut text = String::new();
-    draw(SVGBackend::with_string(&mut text, (900, 600)).into_drawing_area(), p).map_err(|e| plot_err(&svg, e))?;
+    draw(SVGBackend::with_string(&mut text, (WIDTH, HEIGHT)).into_drawing_area(), p).map_err(|e| plot_err(&svg, e))?;
     write_string_atomically(&svg, &text)?;
     // PNG into a hidden temporary file next to the target, renamed over it
     let name = png.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = png.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
-    let drawn = draw(BitMapBackend::new(&tmp, (900, 600)).into_drawing_area(), p);
+    let drawn = draw(BitMapBackend::new(&tmp, (WIDTH, HEIGHT)).into_drawing_area(), p);
     if let Err(e) = drawn {
         let _ = std::fs::remove_file(&tmp);
         return Err(plot_err(&png, e));

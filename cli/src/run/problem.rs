@@ -283,6 +283,9 @@ pub struct ProblemFile {
     pub solver: SolverSpec,
     #[serde(default)]
     pub output: OutputSpec,
+    /// Unit names for labels (see units.rs).
+    #[serde(default)]
+    pub units: Option<super::units::UnitsSpec>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -568,6 +571,9 @@ pub struct OutputSpec {
     /// A node is in the loaded zone when |lambda| > loaded_threshold * max |lambda| (SPEC 6).
     #[serde(default = "default_threshold")]
     pub loaded_threshold: Fraction,
+    /// Lines along which the fields are sampled (see probe.rs).
+    #[serde(default)]
+    pub probe: Vec<Spanned<super::probe::ProbeSpec>>,
 }
 
 fn yes() -> bool {
@@ -587,6 +593,7 @@ impl Default for OutputSpec {
             plot_group: None,
             every_step: true,
             loaded_threshold: default_threshold(),
+            probe: Vec::new(),
         }
     }
 }
@@ -840,6 +847,7 @@ impl Problem {
             return Err(self.error_at(t.span(), "solver.targets", "give `targets` or `steps`, not both"));
         }
         self.check_increments()?;
+        super::probe::check_probes(self, &s.output.probe)?;
         if s.output.plot_axis == PlotAxis::Arc && s.output.plot_group.is_none() {
             return Err(StampError::Input {
                 file: self.path.display().to_string(),

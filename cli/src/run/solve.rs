@@ -3,8 +3,10 @@
 
 use super::build::Setup;
 use super::output::{contact_csv, step_data, Context};
-use super::plot::{write_plot, Plot, Series};
+use super::history::History;
+use super::probe::Probes;
 use super::problem::{PlotAxis, Problem};
+use super::units::Units;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use stamp::io::{write_pvd, write_string_atomically, write_vtu};
@@ -142,20 +144,22 @@ impl Progress {
         }))
     }
 
-    fn step(&self, step: usize, t: f64, path: f64, iterations: usize, active: usize, penetration: f64) {
+    /// `forces`: the punches' forces and travels, appended to the terse line.
+    #[allow(clippy::too_many_arguments)]
+    fn step(&self, step: usize, t: f64, path: f64, iterations: usize, active: usize, penetration: f64, forces: &str) {
         *self.state.lock().unwrap() = (step, t);
-        let msg = format!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact, max penetration {penetration:.2e}");
         if let Some(b) = &self.bar {
             b.set_position(((path / self.path_end) * 1000.0).round().clamp(0.0, 1000.0) as u64);
-            b.set_message(msg);
+            b.set_message(format!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact, max penetration {penetration:.2e}"));
         } else if self.terse {
-            eprintln!("{msg}");
+            eprintln!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact{forces}, max penetration {penetration:.2e}");
         }
     }
 
     fn finish(&self) {
         if let Some(b) = &self.bar {
-            b.finish_and_clear();
+            // the last state stays on the terminal
+            b.finish();
         }
     }
 }
@@ -190,15 +194,14 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
         }
     }
 
-    // plot abscissa of every node (None: not plotted)
+    // sort key of the contact CSV rows: plot_axis coordinate (or arc length) of the plot_group nodes
     let mut axis: Vec<Option<f64>> = vec![None; mesh.mesh.num_nodes()];
-    let (axis_label, plot_nodes): (String, Option<Vec<usize>>) = match (&out.plot_group, out.plot_axis) {
+    match (&out.plot_group, out.plot_axis) {
         (Some(g), PlotAxis::Arc) => {
             let chain = mesh.curve_chain(g.get_ref()).ok_or_else(|| super::mesh::group_error(p, g.span(), "output.plot_group", g.get_ref(), "curve", &mesh))?;
             for &(n, s) in &chain {
                 axis[n] = Some(s);
             }
-            (format!("arc length along '{}' (reference)", g.get_ref()), Some(chain.iter().map(|c| c.0).collect()))
         }
         (g, a) => {
             let c = if a == PlotAxis::X1 { 0 } else { 1 };
@@ -206,13 +209,16 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
                 Some(g) => Some(mesh.nodes(g.get_ref()).ok_or_else(|| super::mesh::group_error(p, g.span(), "output.plot_group", g.get_ref(), "", &mesh))?),
                 None => None,
             };
-            for n in nodes.clone().unwrap_or_else(|| (0..mesh.mesh.num_nodes()).collect()) {
+            for n in nodes.unwrap_or_else(|| (0..mesh.mesh.num_nodes()).collect()) {
                 axis[n] = Some(mesh.mesh.coords[n][c]);
             }
-            (format!("reference x{}", c + 1), nodes)
         }
-    };
-    let _ = plot_nodes;
+    }
+    let units = Units::new(p.spec.units.as_ref());
+    let punch_names: Vec<String> = punches.iter().map(|i| i.name.clone()).collect();
+    let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.is_some() || c.motion == [0.0; 3])).collect();
+    let mut history = History::new(&punch_keys, &point_groups);
+    let mut probes = Probes::new(p, &mesh, &out.probe, &punch_names)?;
 
     let mut summary = Summary {
         problem: p.path.display().to_string(),
@@ -255,8 +261,6 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     let pvd_path = out_dir.join(format!("{stem}.pvd"));
     let mut pvd: Vec<(f64, String)> = Vec::new();
     let mut files: Vec<PathBuf> = Vec::new();
-    // per punch: (label, points) of every written step, for the plot
-    let mut plot_data: Vec<Vec<Series>> = punches.iter().map(|_| Vec::new()).collect();
     let mut write_error: Option<StampError> = None;
     let mut total_iterations = 0;
     // a reader sees "running" (with our pid) from the start
@@ -279,15 +283,22 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
         t_last = t;
         let penetration = m.contacts.iter().map(|c| c.max_penetration()).fold(0.0, f64::max);
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
-        progress.step(rep.step, t, path_len, rep.iterations, active, penetration);
-        if write_error.is_some() || !(out.every_step || rep.is_target) {
+        let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u).clone();
+        progress.step(rep.step, t, path_len, rep.iterations, active, penetration, &history.terse_forces());
+        if write_error.is_some() {
+            return;
+        }
+        if let Err(e) = history.write_csv(out_dir) {
+            write_error = Some(e);
+            return;
+        }
+        if !(out.every_step || rep.is_target) {
             return;
         }
         let mut data = step_data(&cx, m, u, t, path_len, rep);
         // the step's files first; only when all of them are written is the step listed (.pvd and
         // summary.json), and a step that failed half-way leaves no file behind
         let mut written: Vec<PathBuf> = Vec::new();
-        let mut step_plots: Vec<(usize, Series)> = Vec::new();
         let step_files: Result<()> = (|| {
             if out.vtu {
                 let name = format!("{stem}_{:04}.vtu", rep.step);
@@ -310,10 +321,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
                     written.push(path);
                     data.entry.csv.push(name);
                 }
-                if out.plot {
-                    let pts: Vec<(f64, f64)> = rows.iter().filter_map(|r| axis[r.node].map(|s| (s, r.q_n))).collect();
-                    step_plots.push((k, Series { label: format!("t = {t:.4}"), points: pts }));
-                }
+            }
+            for path in probes.write_step(out_dir, rep.step, &row, &punch_names, &m.contacts, u)? {
+                data.entry.csv.push(path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default());
+                written.push(path);
             }
             if let Some(name) = &data.entry.vtu {
                 // the .pvd time is the path length: it increases when the load goes down again
@@ -337,9 +348,6 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
         match step_result {
             Ok(()) => {
                 files.append(&mut written);
-                for (k, series) in step_plots {
-                    plot_data[k].push(series);
-                }
             }
             Err(e) => {
                 if listed {
@@ -380,22 +388,17 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
             Err(e) => failure = failure.or(Some(e)),
         }
     }
-    if out.plot {
-        for (k, info) in punches.iter().enumerate() {
-            let mut series = std::mem::take(&mut plot_data[k]);
-            // at most 10 curves: keep them evenly spread, always the last
-            if series.len() > 10 {
-                let n = series.len();
-                let keep: Vec<usize> = (0..10).map(|i| (i * (n - 1)) / 9).collect();
-                series = series.into_iter().enumerate().filter(|(i, _)| keep.contains(i)).map(|(_, s)| s).collect();
-            }
-            let title = format!("contact pressure under '{}'", info.name);
-            let plot = Plot { title: &title, x_label: &axis_label, y_label: "contact pressure q_n", series: &series };
-            match write_plot(&out_dir.join(format!("pressure_{}", info.name)), &plot) {
-                Ok(f) => files.extend(f),
-                Err(e) => failure = failure.or(Some(e)),
-            }
-        }
+    let finals: Result<()> = (|| {
+        files.push(history.write_csv(out_dir)?);
+        files.extend(history.plot_force_travel(out_dir, &units)?);
+        files.extend(probes.plot(out_dir, &history, &units)?);
+        Ok(())
+    })();
+    if let Err(e) = finals {
+        failure = failure.or(Some(e));
+    }
+    if !quiet {
+        print!("{}", super::table::render(&history, &units));
     }
     summary.seconds = start.elapsed().as_secs_f64();
     match &failure {
