@@ -11,7 +11,7 @@
 //!
 //! A run that was killed leaves `status = "running"`: the next claim then removes only the files
 //! that are not in `before` *and* are named like stamp's outputs (summary.json, *.vtu, *.pvd,
-//! pressure_*.csv/.png/.svg). A folder written before manifests existed (summary.json without a
+//! pressure_*, probe_*, force_travel_* .csv/.png/.svg, history.csv). A folder written before manifests existed (summary.json without a
 //! manifest) loses what that summary.json names: summary.json, the steps' .vtu and .csv files,
 //! the .pvd and the punches' pressure plots.
 
@@ -70,7 +70,9 @@ fn looks_like_output(name: &str) -> bool {
     name == "summary.json"
         || name.ends_with(".vtu")
         || name.ends_with(".pvd")
-        || (name.starts_with("pressure_") && (name.ends_with(".csv") || name.ends_with(".png") || name.ends_with(".svg")))
+        || name == "history.csv"
+        || ((name.starts_with("pressure_") || name.starts_with("probe_") || name.starts_with("force_travel_"))
+            && (name.ends_with(".csv") || name.ends_with(".png") || name.ends_with(".svg")))
 }
 
 /// The files a summary.json written without a manifest names.

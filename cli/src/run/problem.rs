@@ -557,8 +557,9 @@ pub struct OutputSpec {
     /// Write the contact-pressure CSV per step and punch.
     #[serde(default = "yes")]
     pub csv: bool,
-    /// Plot q_n along the contact face (PNG and SVG).
-    #[serde(default)]
+    /// Draw the probe plots (PNG and SVG); with no `[[output.probe]]`, a default probe through the
+    /// first contact point along x1. On by default.
+    #[serde(default = "yes")]
     pub plot: bool,
     #[serde(default)]
     pub plot_axis: PlotAxis,
@@ -588,7 +589,7 @@ impl Default for OutputSpec {
         OutputSpec {
             vtu: true,
             csv: true,
-            plot: false,
+            plot: true,
             plot_axis: PlotAxis::X2,
             plot_group: None,
             every_step: true,

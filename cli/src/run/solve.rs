@@ -390,8 +390,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     }
     let finals: Result<()> = (|| {
         files.push(history.write_csv(out_dir)?);
-        files.extend(history.plot_force_travel(out_dir, &units)?);
-        files.extend(probes.plot(out_dir, &history, &units)?);
+        if out.plot {
+            files.extend(history.plot_force_travel(out_dir, &units)?);
+            files.extend(probes.plot(out_dir, &history, &units)?);
+        }
         Ok(())
     })();
     if let Err(e) = finals {
