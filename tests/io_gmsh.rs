@@ -229,17 +229,6 @@ fn permuted_dense_node_tags_are_read_by_tag() {
         assert_eq!(a.mesh.coords[node_by_tag(&a, tag)], b.mesh.coords[node_by_tag(&b, tag)], "node {tag}");
     }
 
-    // The pitfall this guards against: mshio drops dense tags and numbers the nodes in file order,
-    // which puts tag 13 at the coordinates of node 15.
-    let bytes = std::fs::read(data("rect_permuted.msh")).unwrap();
-    let raw = mshio::parse_msh_bytes(&bytes).unwrap();
-    let nodes = raw.data.nodes.unwrap();
-    let mut implied = Vec::new();
-    for block in &nodes.node_blocks {
-        assert!(block.node_tags.is_none(), "mshio kept the tags: the fixture no longer tests the pitfall");
-        implied.extend(block.nodes.iter().map(|n| [n.x, n.y]));
-    }
-    assert_ne!(implied[12], a.mesh.coords[node_by_tag(&a, 13)]);
 }
 
 #[test]

@@ -11,5 +11,5 @@ pub mod gmsh;
 pub mod vtk;
 
 pub use atomic::{write_atomically, write_string_atomically};
-pub use gmsh::{read_msh, GmshMesh, PhysicalGroup, PhysicalName};
+pub use gmsh::{parse_msh_bytes, read_msh, GmshMesh, PhysicalGroup, PhysicalName, SourceCells};
 pub use vtk::{write_pvd, write_vtu, Field};
