@@ -244,9 +244,23 @@ fn msh40_is_refused_with_a_conversion_hint() {
 }
 
 #[test]
-fn triangles_are_refused_naming_type_and_element() {
-    let e = error_of(&data("tri.msh"));
-    assert_contains(&e, &["tri.msh", "element 3 ", "type 2", "Tri3", "4-node quadrilaterals"]);
+fn triangles_are_accepted_and_cut_into_quadrilaterals() {
+    let m = read("tri.msh");
+    assert_eq!(m.source_cells.len(), 1);
+    assert_eq!((m.source_cells[0].elements, m.source_cells[0].cells), (4, 12));
+    assert_eq!(m.mesh.num_cells(), 12);
+    assert!((total_area(&m) - 2.0).abs() < 1e-12);
+    assert_eq!(m.curve_group("bottom").unwrap().len(), 4);
+}
+
+#[test]
+fn unsupported_element_types_are_named_in_words_with_their_tag() {
+    // The quadrilateral block of rect.msh relabelled as 8-node hexahedra (type 5).
+    let p = edited("hex", "rect.msh", &[("2 1 3 8\n", "2 1 5 8\n")]);
+    let e = error_of(&p);
+    assert_contains(&e, &["rect.msh", "element 15", "type 5", "8-node hexahedron", "stamp accepts"]);
+    let p = edited("cubic", "rect.msh", &[("2 1 3 8\n", "2 1 21 8\n")]);
+    assert_contains(&error_of(&p), &["element 15", "10-node triangle (third order)"]);
 }
 
 #[test]
