@@ -383,12 +383,19 @@ fn convert(path: &Path, raw: RawMsh) -> Result<GmshMesh> {
         }
         let [x, y, z] = raw.node_coords[i];
         if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-            return Err(err(format!("node {} has a non-finite coordinate ({x}, {y}, {z})", raw.node_tags[i])));
+            return Err(err(format!(
+                "node {} has a non-finite coordinate ({}, {}, {})",
+                raw.node_tags[i],
+                short(x),
+                short(y),
+                short(z)
+            )));
         }
         if z.abs() > 1e-12 * extent.max(1e-300) {
             return Err(err(format!(
-                "node {} has z = {z}: the plate must lie in the x1-x2 plane (z = 0 everywhere)",
-                raw.node_tags[i]
+                "node {} has z = {}: the plate must lie in the x1-x2 plane (z = 0 everywhere)",
+                raw.node_tags[i],
+                short(z)
             )));
         }
         file_index[i] = coords.len();
@@ -586,6 +593,15 @@ fn convert(path: &Path, raw: RawMsh) -> Result<GmshMesh> {
         curve_groups,
         reoriented,
     })
+}
+
+/// A number for a message: plain when of moderate size, else in exponent form (never 300 digits).
+fn short(x: f64) -> String {
+    if x == 0.0 || (x.abs() >= 1e-4 && x.abs() < 1e9) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 fn join_tags(tags: &[u64]) -> String {
