@@ -479,3 +479,19 @@ fn only_regular_files_are_read() {
         assert_contains(&error_of(Path::new("/dev/null")), &["/dev/null", "not a regular file"]);
     }
 }
+
+#[test]
+fn the_shipped_meshes_pass_the_whole_mesh_checks() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().is_some_and(|e| e == "msh") {
+            let m = read_msh(&p).unwrap_or_else(|e| panic!("{e}"));
+            stamp::mesh_check::check_mesh(&m.mesh).unwrap();
+            assert!(m.split_summary().is_none(), "{}: {:?}", p.display(), m.split_summary());
+            n += 1;
+        }
+    }
+    assert!(n >= 3);
+}
