@@ -133,4 +133,11 @@ fn mesh_check_cost() {
         check_mesh(&m).unwrap();
         println!("check_mesh on {} cells: {:.3} s", m.num_cells(), t.elapsed().as_secs_f64());
     }
+    // The whole reader on the same mesh as an ASCII file (parse, convert, check).
+    let tags: Vec<(u64, [u64; 4])> =
+        m.cells.iter().enumerate().map(|(c, n)| (c as u64 + 1, n.map(|i| i as u64 + 1))).collect();
+    let text = msh(&m.coords, &tags);
+    let t = std::time::Instant::now();
+    let g = parse_msh_bytes(Path::new("big.msh"), text.as_bytes()).unwrap();
+    println!("parse_msh_bytes of {} bytes, {} cells: {:.3} s", text.len(), g.mesh.num_cells(), t.elapsed().as_secs_f64());
 }

@@ -484,9 +484,9 @@ fn read_nodes(c: &mut Cursor, raw: &mut RawMsh) -> Result<()> {
             }
             raw.node_tags.push(tag);
         }
-        for k in 0..n {
-            let what = format!("the coordinates of node {}", raw.node_tags[first + k]);
-            raw.node_coords.push([c.double(&what)?, c.double(&what)?, c.double(&what)?]);
+        for _ in 0..n {
+            let what = "node coordinates";
+            raw.node_coords.push([c.double(what)?, c.double(what)?, c.double(what)?]);
         }
     }
     if raw.node_tags.len() != total {
@@ -554,7 +554,7 @@ fn read_elements(c: &mut Cursor) -> Result<Vec<ElementBlock>> {
             }
             tags.push(tag);
             for _ in 0..nn {
-                nodes.push(c.size(&format!("a node tag of element {tag}"))?);
+                nodes.push(c.size("the node tags of an element")?);
             }
         }
         all_tags.extend_from_slice(&tags);
