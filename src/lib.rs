@@ -9,6 +9,7 @@
 pub mod error;
 pub mod io;
 pub mod mesh;
+pub mod mesh_check;
 pub mod surface;
 
 pub use error::{quote, Result, StampError};

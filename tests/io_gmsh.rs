@@ -229,17 +229,6 @@ fn permuted_dense_node_tags_are_read_by_tag() {
         assert_eq!(a.mesh.coords[node_by_tag(&a, tag)], b.mesh.coords[node_by_tag(&b, tag)], "node {tag}");
     }
 
-    // The pitfall this guards against: mshio drops dense tags and numbers the nodes in file order,
-    // which puts tag 13 at the coordinates of node 15.
-    let bytes = std::fs::read(data("rect_permuted.msh")).unwrap();
-    let raw = mshio::parse_msh_bytes(&bytes).unwrap();
-    let nodes = raw.data.nodes.unwrap();
-    let mut implied = Vec::new();
-    for block in &nodes.node_blocks {
-        assert!(block.node_tags.is_none(), "mshio kept the tags: the fixture no longer tests the pitfall");
-        implied.extend(block.nodes.iter().map(|n| [n.x, n.y]));
-    }
-    assert_ne!(implied[12], a.mesh.coords[node_by_tag(&a, 13)]);
 }
 
 #[test]
@@ -255,9 +244,23 @@ fn msh40_is_refused_with_a_conversion_hint() {
 }
 
 #[test]
-fn triangles_are_refused_naming_type_and_element() {
-    let e = error_of(&data("tri.msh"));
-    assert_contains(&e, &["tri.msh", "element 3 ", "type 2", "Tri3", "4-node quadrilaterals"]);
+fn triangles_are_accepted_and_cut_into_quadrilaterals() {
+    let m = read("tri.msh");
+    assert_eq!(m.source_cells.len(), 1);
+    assert_eq!((m.source_cells[0].elements, m.source_cells[0].cells), (4, 12));
+    assert_eq!(m.mesh.num_cells(), 12);
+    assert!((total_area(&m) - 2.0).abs() < 1e-12);
+    assert_eq!(m.curve_group("bottom").unwrap().len(), 4);
+}
+
+#[test]
+fn unsupported_element_types_are_named_in_words_with_their_tag() {
+    // The quadrilateral block of rect.msh relabelled as 8-node hexahedra (type 5).
+    let p = edited("hex", "rect.msh", &[("2 1 3 8\n", "2 1 5 8\n")]);
+    let e = error_of(&p);
+    assert_contains(&e, &["rect.msh", "element 15", "type 5", "8-node hexahedron", "stamp accepts"]);
+    let p = edited("cubic", "rect.msh", &[("2 1 3 8\n", "2 1 21 8\n")]);
+    assert_contains(&error_of(&p), &["element 15", "10-node triangle (third order)"]);
 }
 
 #[test]
@@ -361,4 +364,134 @@ fn names_with_spaces_and_shared_names() {
     assert_eq!(m.point_group("edge").unwrap().len(), 1);
     assert_eq!(m.curve_group("edge").unwrap().len(), 4);
     assert_eq!(m.node_group("edge").unwrap().len(), 5);
+}
+
+/// The message of parsing edited bytes of a fixture (no file written).
+fn bytes_error(fixture: &str, edit: impl Fn(Vec<u8>) -> Vec<u8>) -> String {
+    let bytes = edit(std::fs::read(data(fixture)).unwrap());
+    match stamp::io::parse_msh_bytes(Path::new(fixture), &bytes) {
+        Ok(_) => panic!("{fixture} edited was accepted"),
+        Err(e) => {
+            let m = e.to_string();
+            assert!(m.len() < 400, "message of {} characters: {m}", m.len());
+            m
+        }
+    }
+}
+
+fn replace(old: &str, new: &str) -> impl Fn(Vec<u8>) -> Vec<u8> {
+    let (old, new) = (old.as_bytes().to_vec(), new.as_bytes().to_vec());
+    move |b: Vec<u8>| {
+        let p = b.windows(old.len()).position(|w| w == old.as_slice()).expect("fixture lacks the text");
+        [&b[..p], new.as_slice(), &b[p + old.len()..]].concat()
+    }
+}
+
+#[test]
+fn huge_counts_are_refused_without_allocating() {
+    for count in ["1000000000000", "18446744073709551615", "9223372036854775808"] {
+        let e = bytes_error("rect.msh", replace("$PhysicalNames\n5\n", &format!("$PhysicalNames\n{count}\n")));
+        assert_contains(&e, &["rect.msh", "$PhysicalNames", count, "bytes left"]);
+        let e = bytes_error("rect.msh", replace("$Nodes\n9 15 1 15\n", &format!("$Nodes\n9 {count} 1 15\n")));
+        assert_contains(&e, &["$Nodes", "number of nodes", count]);
+        let e = bytes_error("rect.msh", replace("$Elements\n7 22 1 22\n", &format!("$Elements\n{count} 22 1 22\n")));
+        assert_contains(&e, &["$Elements", "element blocks", count]);
+        let e = bytes_error("rect.msh", replace("$Entities\n4 4 1 0\n", &format!("$Entities\n4 {count} 1 0\n")));
+        assert_contains(&e, &["$Entities", "curve entities", count]);
+        let e = bytes_error("rect.msh", replace("2 1 3 8\n", &format!("2 1 3 {count}\n")));
+        assert_contains(&e, &["$Elements", "block 7", count]);
+    }
+    let e = bytes_error("rect.msh", replace("$PhysicalNames\n5\n", "$PhysicalNames\n-1\n"));
+    assert_contains(&e, &["$PhysicalNames", "number of physical names", "'-1'"]);
+    // binary: the node count of the first block set to 2^64 - 1
+    let e = bytes_error("rect_bin.msh", |mut b| {
+        let p = b.windows(7).position(|w| w == b"$Nodes\n").unwrap() + 7;
+        // header: 4 size_t; block: 3 ints then the count
+        b[p + 32 + 12..p + 32 + 20].copy_from_slice(&u64::MAX.to_le_bytes());
+        b
+    });
+    assert_contains(&e, &["rect_bin.msh", "$Nodes", "18446744073709551615", "bytes left"]);
+}
+
+#[test]
+fn header_counts_and_tags_must_match_the_blocks() {
+    let e = bytes_error("rect.msh", replace("$Nodes\n9 15 1 15\n", "$Nodes\n9 14 1 15\n"));
+    assert_contains(&e, &["$Nodes", "more nodes than the 14"]);
+    let e = bytes_error("rect.msh", replace("$Nodes\n9 15 1 15\n", "$Nodes\n9 15 1 16\n"));
+    assert_contains(&e, &["$Nodes", "1 to 16", "1 to 15"]);
+    let e = bytes_error("rect.msh", replace("$Elements\n7 22 1 22\n", "$Elements\n7 23 1 22\n"));
+    assert_contains(&e, &["$Elements", "announces 23 elements", "hold 22"]);
+    let e = bytes_error("rect.msh", replace("$Elements\n7 22 1 22\n", "$Elements\n7 22 2 22\n"));
+    assert_contains(&e, &["$Elements", "element tags 2 to 22", "from 1 to 22"]);
+    let e = bytes_error("rect.msh", replace("\n5\n6\n7\n", "\n5\n0\n7\n"));
+    assert_contains(&e, &["node tag 0 is invalid"]);
+    let e = bytes_error("rect.msh", replace("\n5\n6\n7\n", "\n5\n5\n7\n"));
+    assert_contains(&e, &["node tag 5 appears more than once"]);
+    let e = bytes_error("rect.msh", replace("\n15 1 5 13 12 \n", "\n0 1 5 13 12 \n"));
+    assert_contains(&e, &["element tag 0 is invalid"]);
+    let e = bytes_error("rect.msh", replace("\n15 1 5 13 12 \n", "\n16 1 5 13 12 \n"));
+    assert_contains(&e, &["element tag 16 appears more than once"]);
+    let e = bytes_error("rect.msh", replace("\n22 15 8 3 9 \n", "\n22 5 13 12 1 \n"));
+    assert_contains(&e, &["elements 15 and 22 are duplicates"]);
+}
+
+#[test]
+fn unterminated_sections_are_named() {
+    for section in ["PhysicalNames", "Entities", "Nodes", "Elements"] {
+        let end = format!("$End{section}\n");
+        let e = bytes_error("rect.msh", replace(&end, ""));
+        assert_contains(&e, &["rect.msh", &format!("${section} section"), &format!("$End{section}")]);
+        let e = bytes_error("rect_bin.msh", replace(&end, ""));
+        assert_contains(&e, &["rect_bin.msh", &format!("${section} section"), &format!("$End{section}")]);
+    }
+    // A block count one too small leaves data where $EndNodes should be.
+    let e = bytes_error("rect.msh", replace("$Nodes\n9 15 1 15\n", "$Nodes\n8 15 1 15\n"));
+    assert_contains(&e, &["$Nodes", "hold"]);
+}
+
+#[test]
+fn binary_garbage_is_not_echoed() {
+    // The binary node section's coordinates overwritten with text-like and control bytes after
+    // breaking the counts: the message stays short and printable.
+    let e = bytes_error("rect_bin.msh", |mut b| {
+        let p = b.windows(7).position(|w| w == b"$Nodes\n").unwrap() + 7;
+        for (k, x) in b[p..p + 400].iter_mut().enumerate() {
+            *x = if k % 3 == 0 { 0 } else { 0x41 + (k % 26) as u8 };
+        }
+        b
+    });
+    assert!(e.chars().all(|c| !c.is_control()), "{e}");
+    let e = bytes_error("rect.msh", replace("$Nodes\n", &format!("$Garbage\n{}\n$Nodes\n", "\u{1}x".repeat(500))));
+    assert!(e.chars().all(|c| !c.is_control()), "{e}");
+}
+
+#[test]
+fn only_regular_files_are_read() {
+    let dir = scratch("kinds");
+    assert_contains(&error_of(&dir), &["io_gmsh-kinds", "directory"]);
+    #[cfg(unix)]
+    {
+        let fifo = dir.join("pipe.msh");
+        let status = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        assert!(status.success());
+        // Would block forever if the reader opened it.
+        assert_contains(&error_of(&fifo), &["pipe.msh", "not a regular file"]);
+        assert_contains(&error_of(Path::new("/dev/null")), &["/dev/null", "not a regular file"]);
+    }
+}
+
+#[test]
+fn the_shipped_meshes_pass_the_whole_mesh_checks() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().is_some_and(|e| e == "msh") {
+            let m = read_msh(&p).unwrap_or_else(|e| panic!("{e}"));
+            stamp::mesh_check::check_mesh(&m.mesh).unwrap();
+            assert!(m.split_summary().is_none(), "{}: {:?}", p.display(), m.split_summary());
+            n += 1;
+        }
+    }
+    assert!(n >= 3);
 }
