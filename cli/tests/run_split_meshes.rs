@@ -76,3 +76,25 @@ fn nine_node_quadrilaterals_give_the_quadrilateral_answer() {
 fn eight_node_quadrilaterals_give_the_quadrilateral_answer() {
     compare("quad8", "quad8.msh", 14);
 }
+
+#[test]
+fn check_says_what_the_reader_cut() {
+    let dir = temp_dir("split-check");
+    let mesh = repo().join("tests/data/quarter/mixed.msh");
+    let file = dir.join("mixed.toml");
+    std::fs::write(&file, problem(&format!("file = {:?}", mesh.display().to_string()), &["edge"])).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(&file).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let line = text.lines().find(|l| l.contains("cut into 4-node plate elements")).unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("3-node triangles split into") && line.contains("quadrilaterals"), "{line}");
+}
+
+#[test]
+fn a_mesh_given_for_the_problem_file_is_named_as_such() {
+    let mesh = repo().join("tests/data/quarter/mixed.msh");
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(&mesh).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("mixed.msh") && err.contains("is a gmsh mesh, not a problem file"), "{err}");
+}

@@ -399,6 +399,9 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
         }
     };
     let _ = writeln!(o, "mesh: {source}: {} nodes, {} elements", mesh.mesh.num_nodes(), mesh.mesh.num_cells());
+    if let Some(split) = &mesh.split {
+        let _ = writeln!(o, "  cut into 4-node plate elements: {split}");
+    }
     let ps = s.plate.get_ref();
     let _ = writeln!(
         o,

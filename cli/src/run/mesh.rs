@@ -24,6 +24,9 @@ pub struct MeshData {
     pub node_tags: Option<Vec<u64>>,
     /// gmsh element tag of each cell (for error messages), if read from gmsh.
     pub cell_tags: Option<Vec<u64>>,
+    /// What the reader cut into 4-node cells (triangles, second-order cells), e.g. "113 3-node
+    /// triangles split into 339 quadrilaterals"; None when the file's cells were used as they are.
+    pub split: Option<String>,
 }
 
 impl MeshData {
@@ -37,7 +40,8 @@ impl MeshData {
             }
             let g = read_msh(&path)?;
             let surfaces = g.mesh.cell_groups.clone();
-            Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh })
+            let split = g.split_summary();
+            Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh, split })
         } else {
             let r = spec.rectangle.as_ref().expect("checked: file or rectangle");
             let (nx, ny) = (r.n[0], r.n[1]);
@@ -68,7 +72,7 @@ impl MeshData {
                 mesh.node_groups.insert(k.clone(), v.clone());
             }
             let surfaces = mesh.cell_groups.clone();
-            Ok(MeshData { mesh, points, curves, surfaces, node_tags: None, cell_tags: None })
+            Ok(MeshData { mesh, points, curves, surfaces, node_tags: None, cell_tags: None, split: None })
         }
     }
 

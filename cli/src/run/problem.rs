@@ -731,6 +731,12 @@ impl Problem {
 
     /// Parse problem text (`path` names it in errors and anchors relative paths).
     pub fn parse(path: &Path, source: String) -> Result<Problem> {
+        if source.trim_start().starts_with("$MeshFormat") {
+            return Err(StampError::Input {
+                file: path.display().to_string(),
+                message: "this is a gmsh mesh, not a problem file: write a problem file (TOML) whose [mesh] file = names it".into(),
+            });
+        }
         let spec: ProblemFile = toml::from_str(&source).map_err(|e| StampError::Input { file: path.display().to_string(), message: toml_message(&source, &e) })?;
         let p = Problem { path: path.to_path_buf(), source, spec };
         p.check()?;
