@@ -184,6 +184,20 @@ fn sphere_displacement_driven() {
 }
 
 #[test]
+fn clamped_disk_on_gmsh_default_triangles() {
+    // meshes/disk-clamped.toml: a quarter disk of gmsh's default triangles, cut into quadrilaterals
+    let (s, _) = run_mesh("disk-clamped");
+    check_common("disk-clamped", &s);
+    let st = steps(&s);
+    let r: Vec<f64> = st.iter().map(|e| -f(&e["reaction"][2])).collect();
+    assert!(r.windows(2).all(|w| w[1] > w[0]) && r[0] > 0.0, "{r:?}");
+    // the punch reached its travel, and the contact zone grew
+    assert!((f(&st.last().unwrap()["punches"]["sphere"]["displacement"][2]) + 0.9).abs() < 1e-12);
+    let active: Vec<f64> = st.iter().map(|e| f(&e["active_nodes"])).collect();
+    assert!(active.last().unwrap() > &active[0], "{active:?}");
+}
+
+#[test]
 fn sphere_full_model() {
     let (s, _) = run_mesh("sphere-ss-full");
     check_common("sphere-ss-full", &s);
