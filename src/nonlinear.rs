@@ -12,7 +12,7 @@
 //! early ([`NewtonSettings::cycling_after`], off by default).
 
 use crate::error::{Result, StampError};
-use crate::linear_solver::LinearSolver;
+use crate::linalg::linear_solver::LinearSolver;
 use faer::sparse::SparseColMatRef;
 use std::time::Instant;
 

@@ -19,7 +19,7 @@ use common::euler_krylov;
 use nalgebra::{Matrix3, Vector3};
 use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
 use stamp::dofs::DofMap;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
