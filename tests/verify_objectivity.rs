@@ -140,9 +140,9 @@ fn arbitrary_rotation_of_the_deformed_state_is_equilibrium() {
 
 /// The same on general quadrilaterals (interior nodes moved by 1 %, 10 % and 30 % of the element
 /// size). Their transverse shear is the tying interpolation of the FULL Green-Lagrange strain at the
-/// edge midpoints (elements/src/geometry.rs), so it is objective. An earlier version corrected only
-/// the linear part of the shear there, which a superposed rotation changes: this test measured the
-/// nodal forces of the rotated state off by 1 % (1 % distortion) to 28 % (30 %).
+/// edge midpoints (elements/src/geometry.rs), so it is objective. Tying only the linear part of the
+/// shear there would not be: a superposed rotation changes it, and this test then finds the nodal
+/// forces of the rotated state off by 1 % (1 % distortion) to 28 % (30 %).
 #[test]
 fn arbitrary_rotation_of_the_deformed_state_on_a_distorted_mesh() {
     for d in [0.01, 0.1, 0.3] {
