@@ -4,7 +4,7 @@
 //!     cargo run --release --example ellipsoid_punch
 
 use nalgebra::{Matrix3, Vector3};
-use stamp::bordered::BorderedSolver;
+use stamp::linalg::bordered::BorderedSolver;
 use stamp::contact::{automatic_eps_reg, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;

@@ -15,7 +15,7 @@
 use crate::dofs::DofMap;
 use crate::element::{Element, LocalSystem};
 use crate::error::{Result, StampError};
-use crate::sparse::SparsePattern;
+use crate::linalg::sparse::SparsePattern;
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -189,9 +189,9 @@ impl Assembler {
         let eqs = dofs.equations();
         let mut energy = 0.0;
         let local_system = || if with_preconditioner { LocalSystem::with_preconditioner(nloc) } else { LocalSystem::new(nloc) };
-        // (a worker thread may come from faer's kernels: see crate::vector_state)
+        // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
         let init = || {
-            crate::vector_state::clean_upper_vector_state();
+            crate::linalg::vector_state::clean_upper_vector_state();
             (element.new_workspace(), local_system(), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc])
         };
         // per-thread scratch: workspace, local system, local values, global dofs, row ranks

@@ -60,7 +60,7 @@ pub trait Element: Sync {
     fn element_nodes(&self, e: usize) -> &[usize];
     /// Whether `evaluate` also gives a symmetric matrix P close to a non-symmetric tangent, whose
     /// factorisation preconditions the linear solves better than the tangent's symmetric part
-    /// (see [`crate::ldlt_gmres`]). Default: no.
+    /// (see [`crate::linalg::ldlt_gmres`]). Default: no.
     fn has_preconditioner(&self) -> bool {
         false
     }

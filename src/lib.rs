@@ -4,7 +4,8 @@
 //! Data flows one way: mesh -> degrees of freedom -> assembly -> nonlinear solver -> output. This crate
 //! knows nothing about plates or cylinders: elements plug in through [`element::Element`], punch
 //! shapes through [`surface::ContactSurface`], solution strategies through
-//! [`nonlinear::NonlinearSolver`].
+//! [`nonlinear::NonlinearSolver`], linear solvers through
+//! [`linalg::linear_solver::LinearSolver`] (the sparse linear algebra lives in [`linalg`]).
 
 pub mod error;
 pub mod io;
@@ -15,15 +16,8 @@ pub mod surface;
 pub use error::{quote, Result, StampError};
 pub mod dofs;
 pub mod element;
-pub mod linear_solver;
-pub mod gmres;
-pub mod ldlt_gmres;
-pub mod supernodal_solve;
-pub mod ordering;
-pub mod bordered;
-pub mod sparse;
+pub mod linalg;
 pub mod assembly;
-pub mod vector_state;
 pub mod contact;
 pub mod model;
 pub mod nonlinear;

@@ -13,7 +13,7 @@ use crate::dofs::DofMap;
 use crate::element::Element;
 use crate::error::{Result, StampError};
 use crate::nonlinear::{Evaluation, NonlinearProblem};
-use crate::sparse::SparsePattern;
+use crate::linalg::sparse::SparsePattern;
 use faer::sparse::SparseColMatRef;
 use std::time::Instant;
 

@@ -12,7 +12,7 @@
 //! early ([`NewtonSettings::cycling_after`], off by default).
 
 use crate::error::{Result, StampError};
-use crate::linear_solver::LinearSolver;
+use crate::linalg::linear_solver::LinearSolver;
 use faer::sparse::SparseColMatRef;
 use std::time::Instant;
 
@@ -574,7 +574,7 @@ mod tests {
     //! R(u, t) = u - t whose residual can be made NaN past a load factor, and whose end_step can
     //! refuse every converged state (an augmented-Lagrangian tolerance that is never met).
     use super::*;
-    use crate::linear_solver::SparseLu;
+    use crate::linalg::linear_solver::SparseLu;
     use faer::sparse::SymbolicSparseColMatRef;
 
     struct Line {

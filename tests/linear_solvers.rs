@@ -3,8 +3,8 @@
 
 mod common;
 use common::sphere::*;
-use stamp::ldlt_gmres::{LdltGmres, Ordering};
-use stamp::linear_solver::{LinearSolver, SparseLu};
+use stamp::linalg::ldlt_gmres::{LdltGmres, Ordering};
+use stamp::linalg::linear_solver::{LinearSolver, SparseLu};
 use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
 
 fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
@@ -113,8 +113,8 @@ fn sphere_problem_is_solved_like_the_lu() {
 /// too (its leading block).
 #[test]
 fn plate_preconditioner_saves_gmres_iterations() {
-    use stamp::bordered::BorderedSolver;
-    use stamp::linear_solver::SparseLu;
+    use stamp::linalg::bordered::BorderedSolver;
+    use stamp::linalg::linear_solver::SparseLu;
     let mut p = SphereProblem::new(100.0, 1.0, 16, Support::SimplySoft);
     p.radius = 50.0;
     p.depth = 2.0;
@@ -154,7 +154,7 @@ fn plate_preconditioner_saves_gmres_iterations() {
 #[test]
 fn preconditioner_of_another_pattern_is_refused() {
     use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-    use stamp::bordered::BorderedSolver;
+    use stamp::linalg::bordered::BorderedSolver;
     let (mut model, _, _) = deformed_tangent(4, 3);
     model.want_preconditioner(true);
     let u = vec![0.0; model.num_dofs()];

@@ -7,7 +7,7 @@ use common::*;
 use stamp::dofs::DofMap;
 use stamp::element::{Element, LocalSystem};
 use stamp::io::gmsh::{read_msh, GmshMesh};
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::mesh::{quad_signed_area, QuadMesh};
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver};

@@ -107,15 +107,15 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
         let coupling = (0..neq - 1).map(|i| k[i][s].abs() + k[s][i].abs()).fold(0.0, f64::max);
         assert!(k[s][s].abs() > 1e-3 * scale && coupling > 1e-3 * scale, "K_ss = {}, largest coupling {coupling:e}", k[s][s]);
         // the bordered solver (block elimination) gives the sparse LU's solution of the whole system
-        use stamp::linear_solver::LinearSolver;
+        use stamp::linalg::linear_solver::LinearSolver;
         model.evaluate(&u, 1.0, true).unwrap();
         let r = model.residual().to_vec();
         let mut x_lu = r.clone();
-        let mut lu = stamp::linear_solver::SparseLu::new();
+        let mut lu = stamp::linalg::linear_solver::SparseLu::new();
         lu.factorize(model.matrix()).unwrap();
         lu.solve_in_place(&mut x_lu).unwrap();
         let mut x_b = r.clone();
-        let mut b = stamp::bordered::BorderedSolver::new(1);
+        let mut b = stamp::linalg::bordered::BorderedSolver::new(1);
         b.factorize(model.matrix()).unwrap();
         b.solve_in_place(&mut x_b).unwrap();
         let norm = x_lu.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -131,7 +131,7 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
         assert!(asym < 1e-10 * scale, "P is not symmetric: {asym:e}");
         assert_eq!(pd[(s, s)], model.matrix().to_dense()[(s, s)], "the punch's own entry belongs to P whole");
         let mut x_p = r.clone();
-        let mut b = stamp::bordered::BorderedSolver::with_inner(1, stamp::ldlt_gmres::LdltGmres::new().with_preconditioner(true));
+        let mut b = stamp::linalg::bordered::BorderedSolver::with_inner(1, stamp::linalg::ldlt_gmres::LdltGmres::new().with_preconditioner(true));
         b.factorize_preconditioned(model.matrix(), Some(p)).unwrap();
         b.solve_in_place(&mut x_p).unwrap();
         let diff = x_lu.iter().zip(&x_p).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));

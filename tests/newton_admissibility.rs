@@ -5,7 +5,7 @@
 //! from u = 3 at t = 1 the Newton step goes to 3 - 3 ln 3 = -0.30.
 
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::nonlinear::{Evaluation, NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
 use stamp::{Result, StampError};
 

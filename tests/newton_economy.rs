@@ -7,8 +7,8 @@
 
 mod common;
 use common::sphere::*;
-use stamp::ldlt_gmres::LdltGmres;
-use stamp::linear_solver::{LinearSolver, SparseLu};
+use stamp::linalg::ldlt_gmres::LdltGmres;
+use stamp::linalg::linear_solver::{LinearSolver, SparseLu};
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
 
 fn problem() -> SphereProblem {

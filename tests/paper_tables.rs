@@ -1,7 +1,7 @@
 //! The paper's section-5 benchmark (SPEC section 5): Tables 1 and 2 and the reaction check, solved
 //! through the generic framework exactly as `stamp paper` does.
 
-use stamp_cli::paper::run_paper;
+use stamp_cli::paper::tables::run_paper;
 
 #[test]
 fn tables_1_and_2_and_the_reaction_check() {

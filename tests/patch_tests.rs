@@ -9,7 +9,7 @@ mod common;
 use common::*;
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver};
 use stamp_elements::{Face, Kinematics, PlateElements};

@@ -10,7 +10,7 @@
 
 mod common;
 use common::sphere::*;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NonlinearSolver};
 use stamp_contact::Sphere;

@@ -24,7 +24,7 @@
 
 mod common;
 use common::sphere::*;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::nonlinear::{NewtonRaphson, NonlinearSolver};
 use stamp_elements::Face;
 

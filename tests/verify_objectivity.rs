@@ -19,7 +19,7 @@ use common::euler_krylov;
 use nalgebra::{Matrix3, Vector3};
 use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
 use stamp::dofs::DofMap;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
@@ -140,9 +140,9 @@ fn arbitrary_rotation_of_the_deformed_state_is_equilibrium() {
 
 /// The same on general quadrilaterals (interior nodes moved by 1 %, 10 % and 30 % of the element
 /// size). Their transverse shear is the tying interpolation of the FULL Green-Lagrange strain at the
-/// edge midpoints (elements/src/geometry.rs), so it is objective. An earlier version corrected only
-/// the linear part of the shear there, which a superposed rotation changes: this test measured the
-/// nodal forces of the rotated state off by 1 % (1 % distortion) to 28 % (30 %).
+/// edge midpoints (elements/src/geometry.rs), so it is objective. Tying only the linear part of the
+/// shear there would not be: a superposed rotation changes it, and this test then finds the nodal
+/// forces of the rotated state off by 1 % (1 % distortion) to 28 % (30 %).
 #[test]
 fn arbitrary_rotation_of_the_deformed_state_on_a_distorted_mesh() {
     for d in [0.01, 0.1, 0.3] {

@@ -12,7 +12,7 @@
 
 mod common;
 use common::sphere::*;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::nonlinear::{NewtonRaphson, NonlinearSolver};
 
 fn rel(a: f64, b: f64) -> f64 {

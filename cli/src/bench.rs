@@ -10,8 +10,8 @@ use serde::{Deserialize, Serialize};
 use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
 use stamp::dofs::DofMap;
 use stamp::io::{write_vtu, Field};
-use stamp::linear_solver::LinearSolver;
-use stamp::ldlt_gmres::{LdltGmres, LdltGmresStats};
+use stamp::linalg::linear_solver::LinearSolver;
+use stamp::linalg::ldlt_gmres::{LdltGmres, LdltGmresStats};
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
@@ -263,7 +263,7 @@ pub fn one_command(n: usize, options: SolverOptions) -> Result<()> {
 
 #[cfg(test)]
 mod ordering_measurement {
-    //! Not tests: the measurements behind `stamp::ldlt_gmres::Ordering` (ignored; run with
+    //! Not tests: the measurements behind `stamp::linalg::ldlt_gmres::Ordering` (ignored; run with
     //! `STAMP_ORDERING_SIZES=100,200 cargo test --release -p stamp-cli --lib ordering_ -- --ignored --nocapture --test-threads 1`;
     //! STAMP_ORDERING_NUMERIC=0 skips the numeric factorisations of `ordering_comparison`).
     use super::*;
@@ -297,9 +297,9 @@ mod ordering_measurement {
     /// `nested`, else by faer's AMD, and the seconds METIS took.
     fn ordered_symbolic(neq: usize, cp: &[usize], ri: &[usize], nested: bool) -> (faer::sparse::linalg::cholesky::SymbolicCholesky<usize>, f64) {
         let t0 = Instant::now();
-        let perm = nested.then(|| stamp::ordering::nested_dissection(cp, ri).unwrap());
+        let perm = nested.then(|| stamp::linalg::ordering::nested_dissection(cp, ri).unwrap());
         let t_order = t0.elapsed().as_secs_f64();
-        let inv = perm.as_ref().map(|p| stamp::ordering::inverse(p));
+        let inv = perm.as_ref().map(|p| stamp::linalg::ordering::inverse(p));
         let ord = match (&perm, &inv) {
             (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, neq)),
             _ => SymmetricOrdering::Amd,
@@ -367,7 +367,7 @@ mod ordering_measurement {
 
     /// One solve pair (forward and backward substitution) with the LDL^T factor of the bench
     /// tangent's symmetric part (LdltGmres's ordering: nested dissection from
-    /// `ND_MIN_UNKNOWNS` unknowns on), faer's solve against `stamp::supernodal_solve` (its
+    /// `ND_MIN_UNKNOWNS` unknowns on), faer's solve against `stamp::linalg::supernodal_solve` (its
     /// sequential path, and its parallel one), with 1 and 2 rayon threads, each the minimum of 10
     /// runs taking turns (run with
     /// `STAMP_ORDERING_SIZES=100,200 cargo test --release -p stamp-cli --lib solve_pair -- --ignored --nocapture --test-threads 1`).
@@ -376,14 +376,14 @@ mod ordering_measurement {
     fn solve_pair() {
         use faer::sparse::linalg::cholesky::LdltRef;
         use faer::{Conj, MatMut, Par};
-        use stamp::supernodal_solve::SupernodalSolve;
+        use stamp::linalg::supernodal_solve::SupernodalSolve;
         let sizes = sizes_from_env("STAMP_ORDERING_SIZES", "100,200");
         println!("n | unknowns | nnz(L) | ordering | splits | faer 1 thread s | faer 2 threads s | ours sequential s | ours 1 thread s | ours 2 threads s | max rel. difference");
         for n in sizes {
             let (neq, cp, ri, s) = tangent(n, 0.3);
             let pattern = SymbolicSparseColMatRef::new_checked(neq, neq, &cp, None, &ri);
             let a = SparseColMatRef::new(pattern, &s);
-            let nested = neq >= stamp::ldlt_gmres::ND_MIN_UNKNOWNS;
+            let nested = neq >= stamp::linalg::ldlt_gmres::ND_MIN_UNKNOWNS;
             let (sym, _) = ordered_symbolic(neq, &cp, &ri, nested);
             let par = Par::rayon(2);
             let mut buffer = MemBuffer::new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()).or(sym.solve_in_place_scratch::<f64>(1, par)));
@@ -440,7 +440,7 @@ mod ordering_measurement {
     #[test]
     #[ignore]
     fn ordering_bench() {
-        use stamp::ldlt_gmres::Ordering;
+        use stamp::linalg::ldlt_gmres::Ordering;
         let sizes = sizes_from_env("STAMP_ORDERING_SIZES", "100,200");
         println!("n | ordering | Newton | factorisations | GMRES | symbolic s | factor s | solve s | total s | centre deflection");
         for n in sizes {

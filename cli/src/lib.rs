@@ -1,5 +1,4 @@
 //! The problems and reports behind the `stamp` command-line program.
 pub mod bench;
 pub mod paper;
-pub mod report;
 pub mod run;

@@ -66,8 +66,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => stamp_cli::report::paper_command(false, None),
-        Some(Command::Paper { json, plot }) => stamp_cli::report::paper_command(json, plot.as_deref()),
+        None => stamp_cli::paper::paper_command(false, None),
+        Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
         Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
         Some(Command::Check { problem }) => stamp_cli::run::check_command(&problem),
         Some(Command::Bench { one: Some(n), reuse, symmetric_part, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part }),

@@ -50,7 +50,8 @@ fn sphere_demo_presses_the_plate_symmetrically() {
 #[test]
 fn figure4_is_drawn_with_its_data() {
     let out = temp_dir("figure4");
-    stamp_cli::run::plot_paper_figure4(&out).unwrap();
+    let written = stamp_cli::paper::figure4::write_figure4(&out).unwrap();
+    assert_eq!(written, [out.join("figure4.png"), out.join("figure4.svg"), out.join("figure4.csv")]);
     let png = std::fs::read(out.join("figure4.png")).unwrap();
     assert_eq!(&png[..4], b"\x89PNG");
     let svg = std::fs::read_to_string(out.join("figure4.svg")).unwrap();
@@ -68,4 +69,23 @@ fn figure4_is_drawn_with_its_data() {
     let last: Vec<&Vec<f64>> = rows.iter().filter(|r| r[0] == 80.0).collect();
     assert_eq!(last.len(), 41);
     assert!((last[0][1] - 20.0).abs() < 1e-12, "P~ = 80 is Table 2's P = 20");
+}
+
+#[test]
+fn stamp_paper_plot_says_where_figure4_was_written() {
+    let out = temp_dir("paper-plot");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_stamp")).arg("paper").arg("--plot").arg(&out).output().unwrap();
+    assert!(run.status.success(), "stamp paper --plot failed: {}", String::from_utf8_lossy(&run.stderr));
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("Table 2."), "the tables are printed first: {stdout}");
+    let line = format!("stamp paper: Figure 4 written to {}, .svg, .csv", out.join("figure4.png").display());
+    assert_eq!(stdout.lines().last(), Some(line.as_str()), "{stdout}");
+    for name in ["figure4.png", "figure4.svg", "figure4.csv"] {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+    // with --json stdout stays one JSON document; the message goes to stderr
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_stamp")).args(["paper", "--json", "--plot"]).arg(&out).output().unwrap();
+    assert!(run.status.success());
+    let _: Value = serde_json::from_slice(&run.stdout).expect("stdout is JSON");
+    assert_eq!(String::from_utf8_lossy(&run.stderr).trim_end(), line);
 }

@@ -13,7 +13,7 @@ use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{Section, NSTRAIN};
 use crate::strain::{Affine, Sample, NDOF, NPAIR};
 use stamp::element::{Element, LocalSystem};
-use stamp::vector_state::clean_upper_vector_state;
+use stamp::linalg::vector_state::clean_upper_vector_state;
 use stamp::mesh::QuadMesh;
 use stamp::Result;
 use faer::linalg::matmul::matmul;

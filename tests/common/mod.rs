@@ -56,7 +56,7 @@ pub fn max_abs(v: &[f64]) -> f64 {
 }
 
 use stamp::dofs::DofMap;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver, StepReport};
 use stamp_elements::Face;

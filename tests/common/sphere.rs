@@ -10,7 +10,7 @@
 use super::Lcg;
 use stamp::contact::{ContactKinematics, ContactPair, ContactPoint};
 use stamp::dofs::DofMap;
-use stamp::linear_solver::SparseLu;
+use stamp::linalg::linear_solver::SparseLu;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver, StepReport};

@@ -899,7 +899,7 @@ impl Problem {
         Ok(())
     }
 
-    /// The name of punch `i` (its `name`, or "punch<i>").
+    /// The name of punch `i` (its `name`, or "`punch<i>`").
     pub fn punch_name(&self, i: usize) -> String {
         self.spec.punch[i].get_ref().name.clone().unwrap_or_else(|| if self.spec.punch.len() == 1 { "punch".into() } else { format!("punch{i}") })
     }

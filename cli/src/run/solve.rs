@@ -10,7 +10,7 @@ use super::units::Units;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use stamp::io::{write_pvd, write_string_atomically, write_vtu};
-use stamp::bordered::BorderedSolver;
+use stamp::linalg::bordered::BorderedSolver;
 use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
 use stamp::{Result, StampError};
 use std::io::IsTerminal;

@@ -29,7 +29,7 @@
 //! pattern and reused, with all workspaces, by every numeric factorisation.
 //!
 //! Solves with the factor (the direct ones and GMRES's preconditioner): with a supernodal factor,
-//! the tree-parallel solve of [`crate::supernodal_solve`] (its schedule built with the symbolic
+//! the tree-parallel solve of [`crate::linalg::supernodal_solve`] (its schedule built with the symbolic
 //! phase; on one thread when the parallelism is sequential, still about 30 % faster than faer's);
 //! faer's with a simplicial factor.
 //! Measured with `stamp bench` (2 threads, the quieter of two A/B runs): the solve column at
@@ -38,7 +38,7 @@
 //! and 24 factorisations instead of 32 and 25; n = 100: 28 instead of 27).
 //!
 //! Ordering ([`Ordering`], [`LdltGmres::ordering`]): by default nested dissection (METIS on the
-//! nodal graph, [`crate::ordering::nested_dissection`]) from [`ND_MIN_UNKNOWNS`] unknowns on and
+//! nodal graph, [`crate::linalg::ordering::nested_dissection`]) from [`ND_MIN_UNKNOWNS`] unknowns on and
 //! faer's AMD below. Measured 2026-11-23 on the tangent of `stamp bench`'s plate (n x n, punch
 //! travel 0.6, contact active; the ignored test `ordering_comparison` in cli/src/bench.rs): one
 //! symbolic and three numeric factorisations of its symmetric part per ordering, the numeric ones
@@ -79,10 +79,10 @@
 //! loss below; hence off by default.
 
 use crate::error::{Result, StampError};
-use crate::gmres::{Gmres, GmresReport};
-use crate::linear_solver::{parallelism_for, LinearSolver, SolverTimings, SparseLu};
-use crate::ordering;
-use crate::supernodal_solve::SupernodalSolve;
+use crate::linalg::gmres::{Gmres, GmresReport};
+use crate::linalg::linear_solver::{parallelism_for, LinearSolver, SolverTimings, SparseLu};
+use crate::linalg::ordering;
+use crate::linalg::supernodal_solve::SupernodalSolve;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering};
@@ -114,7 +114,7 @@ pub enum Ordering {
     /// faer's approximate minimum degree.
     Amd,
     /// Nested dissection by METIS on the compressed (nodal) graph,
-    /// [`crate::ordering::nested_dissection`]; AMD if METIS fails.
+    /// [`crate::linalg::ordering::nested_dissection`]; AMD if METIS fails.
     NestedDissection,
     /// Nested dissection from [`ND_MIN_UNKNOWNS`] unknowns on, AMD below (the default).
     #[default]
@@ -392,7 +392,7 @@ impl LdltGmres {
             None => {
                 let n = x.len();
                 LdltRef::new(symbolic, factor).solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, n, 1), par, MemStack::new(buffer));
-                crate::vector_state::clean_upper_vector_state();
+                crate::linalg::vector_state::clean_upper_vector_state();
             }
         }
     }
@@ -547,7 +547,7 @@ fn factorize_numeric(sym: &SymbolicCholesky<usize>, buffer: &mut MemBuffer, fact
     let pattern = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
     let s = SparseColMatRef::new(pattern, values);
     let ok = sym.factorize_numeric_ldlt(factor, s, Side::Lower, LdltRegularization::default(), par, MemStack::new(buffer), Default::default()).is_ok();
-    crate::vector_state::clean_upper_vector_state();
+    crate::linalg::vector_state::clean_upper_vector_state();
     ok && pivots(sym, factor).all(|d| d.is_finite() && d != 0.0)
 }
 
@@ -579,7 +579,7 @@ const ROWS_PER_TASK: usize = 4096;
 fn split_values(col_ptr: &[usize], transpose: &[usize], a: &[f64], row_values: &mut [f64], symmetric: Option<&mut [f64]>, row_sums: &mut [f64], parallel: bool) -> (f64, f64) {
     // the columns first..first + sums.len(), whose entries start at slot `base`
     let columns = |first: usize, base: usize, rows: &mut [f64], mut sym: Option<&mut [f64]>, sums: &mut [f64]| {
-        crate::vector_state::clean_upper_vector_state();
+        crate::linalg::vector_state::clean_upper_vector_state();
         let (mut worst, mut size) = (0.0f64, 0.0f64);
         for (c, sum) in sums.iter_mut().enumerate() {
             let mut total = 0.0;
@@ -633,8 +633,8 @@ fn split_values(col_ptr: &[usize], transpose: &[usize], a: &[f64], row_values: &
 /// y_c = sum_k row_values[k] x[row_idx[k]] over column c. Rows in parallel when `parallel`.
 fn multiply_rows(col_ptr: &[usize], row_idx: &[usize], row_values: &[f64], x: &[f64], y: &mut [f64], parallel: bool) {
     let rows = |first: usize, out: &mut [f64]| {
-        // a worker thread may come from faer's kernels (see crate::vector_state)
-        crate::vector_state::clean_upper_vector_state();
+        // a worker thread may come from faer's kernels (see crate::linalg::vector_state)
+        crate::linalg::vector_state::clean_upper_vector_state();
         for (i, yi) in out.iter_mut().enumerate() {
             let c = first + i;
             *yi = (col_ptr[c]..col_ptr[c + 1]).map(|k| row_values[k] * x[row_idx[k]]).sum();
@@ -689,7 +689,7 @@ fn touch_pages(v: &mut [f64]) {
 /// indices must be sorted within each column (faer's invariant).
 fn transpose_positions(col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize>> {
     let mut out = vec![0usize; row_idx.len()];
-    crate::sparse::pair_transposed(col_ptr, row_idx, |k, partner| out[k] = partner).then_some(out)
+    crate::linalg::sparse::pair_transposed(col_ptr, row_idx, |k, partner| out[k] = partner).then_some(out)
 }
 
 impl LinearSolver for LdltGmres {
@@ -727,7 +727,7 @@ impl LinearSolver for LdltGmres {
         };
         let given = match p {
             Some(p) if self.use_preconditioner => {
-                if !crate::sparse::same_pattern(p.symbolic(), a.symbolic()) {
+                if !crate::linalg::sparse::same_pattern(p.symbolic(), a.symbolic()) {
                     return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into()));
                 }
                 Some(p)
@@ -1106,13 +1106,13 @@ mod tests {
     /// From `PARALLEL_MIN_ROWS` unknowns on, with a supernodal factor, the solves are the
     /// tree-parallel ones; they give the answers (and the GMRES iterations) of the same solve
     /// on one thread, which a sequential solver uses (both against faer's own solve: the unit
-    /// tests of `crate::supernodal_solve`).
+    /// tests of `crate::linalg::supernodal_solve`).
     #[test]
     fn large_matrices_use_the_parallel_supernodal_solve() {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         for skew in [0.0, 0.3] {
             let a = grid(150, skew);
-            assert!(a.nrows() >= crate::linear_solver::PARALLEL_MIN_ROWS);
+            assert!(a.nrows() >= crate::linalg::linear_solver::PARALLEL_MIN_ROWS);
             let mut parallel = LdltGmres::with_parallelism(Par::rayon(2));
             let mut sequential = LdltGmres::with_parallelism(Par::Seq);
             pool.install(|| check_solution(&a, &mut parallel));
@@ -1169,7 +1169,7 @@ mod tests {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         for skew in [0.3, 0.0] {
             let a = grid(150, skew);
-            assert!(a.nrows() >= crate::linear_solver::PARALLEL_MIN_ROWS);
+            assert!(a.nrows() >= crate::linalg::linear_solver::PARALLEL_MIN_ROWS);
             let p = grid(150, 0.0);
             let n = a.nrows();
             let exact: Vec<f64> = (0..n).map(|i| (0.3 * i as f64).cos() + 0.1 * i as f64).collect();

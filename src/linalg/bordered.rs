@@ -14,11 +14,11 @@
 //! z = A11^-1 b1, x2 = S^-1 (b2 - A21 z), x1 = z - Y x2. A11 must be non-singular: the plate is
 //! held by its supports or by displacement-driven punches, not only by the force-driven ones.
 //! With m = 0 it is exactly the inner solver: by default [`LdltGmres`] (the LDL^T of the symmetric
-//! part, GMRES where A11 is not symmetric), or any [`LinearSolver`], e.g. [`crate::linear_solver::SparseLu`].
+//! part, GMRES where A11 is not symmetric), or any [`LinearSolver`], e.g. [`crate::linalg::linear_solver::SparseLu`].
 
 use crate::error::{Result, StampError};
-use crate::ldlt_gmres::LdltGmres;
-use crate::linear_solver::{LinearSolver, SolverTimings};
+use crate::linalg::ldlt_gmres::LdltGmres;
+use crate::linalg::linear_solver::{LinearSolver, SolverTimings};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use nalgebra::DMatrix;
 
@@ -144,7 +144,7 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         let sym11 = self.sym11.as_ref().unwrap().as_ref();
         let a11 = SparseColMatRef::new(sym11, &self.vals11);
         match p {
-            Some(p) if crate::sparse::same_pattern(p.symbolic(), a.symbolic()) => {
+            Some(p) if crate::linalg::sparse::same_pattern(p.symbolic(), a.symbolic()) => {
                 let pv = p.val();
                 self.pre11.clear();
                 self.pre11.extend(self.map11.iter().map(|&k| pv[k]));

@@ -115,7 +115,7 @@ impl LinearSolver for SparseLu {
         let stack = MemStack::new(self.buffer.as_mut().unwrap());
         self.factored = false;
         let result = sym.factorize_numeric_lu(&mut self.numeric, a, par, stack, Default::default());
-        crate::vector_state::clean_upper_vector_state();
+        crate::linalg::vector_state::clean_upper_vector_state();
         result.map_err(|e| StampError::LinearSolver(format!("numeric LU failed (singular matrix?): {e:?}")))?;
         self.factored = true;
         self.timings.factorization += t.elapsed().as_secs_f64();
@@ -135,7 +135,7 @@ impl LinearSolver for SparseLu {
         let par = parallelism_for(n, self.par);
         let stack = MemStack::new(self.buffer.as_mut().unwrap());
         lu.solve_in_place_with_conj(Conj::No, rhs, par, stack);
-        crate::vector_state::clean_upper_vector_state();
+        crate::linalg::vector_state::clean_upper_vector_state();
         self.timings.solve += t.elapsed().as_secs_f64();
         self.timings.solves += 1;
         if b.iter().any(|x| !x.is_finite()) {

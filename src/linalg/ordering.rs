@@ -105,7 +105,7 @@ fn is_closed_symmetric(col_ptr: &[usize], row_idx: &[usize]) -> bool {
         let col = &row_idx[col_ptr[j]..col_ptr[j + 1]];
         col.windows(2).all(|w| w[0] < w[1]) && col.binary_search(&j).is_ok()
     });
-    sorted_with_diagonal && crate::sparse::pair_transposed(col_ptr, row_idx, |_, _| {})
+    sorted_with_diagonal && crate::linalg::sparse::pair_transposed(col_ptr, row_idx, |_, _| {})
 }
 
 /// Group the vertices of a graph by closed neighbourhood; `ptr` / `adj`: the closed

@@ -884,8 +884,8 @@ mod tests {
     fn factorise(a: &SparseColMat<usize, f64>, nested: bool) -> (SymbolicCholesky<usize>, Vec<f64>) {
         let n = a.nrows();
         let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
-        let perm = nested.then(|| crate::ordering::nested_dissection(cp, ri).unwrap());
-        let inv = perm.as_deref().map(crate::ordering::inverse);
+        let perm = nested.then(|| crate::linalg::ordering::nested_dissection(cp, ri).unwrap());
+        let inv = perm.as_deref().map(crate::linalg::ordering::inverse);
         let ord = match (&perm, &inv) {
             (Some(p), Some(i)) => SymmetricOrdering::Custom(PermRef::new_checked(p, i, n)),
             _ => SymmetricOrdering::Amd,

@@ -1,7 +1,6 @@
-//! Printing the paper's benchmark: Tables 1 and 2 in the paper's layout, ours beside the paper's.
+//! The text report of the paper's benchmark: Tables 1 and 2 in the paper's layout, ours beside the paper's.
 
-use crate::paper::{run_paper, PaperReport};
-use std::path::Path;
+use super::tables::{PaperReport, ZoneRow};
 
 fn pct(x: f64) -> String {
     format!("{:+.3}%", 100.0 * x)
@@ -14,7 +13,7 @@ pub fn format_report(r: &PaperReport) -> String {
     s.push_str("Table 1. R = 1000 mm (shallow), P/2 on each end. Zones [b_int, b_ext] in mm: ours (paper); v3(l) in mm: ours, paper, difference\n");
     s.push_str(&format!("{:>5} | {:^25} {:>8} {:>7} {:>9} | {:^25} {:>8} {:>7} {:>9}\n", "P", "linear zone", "v3", "paper", "diff", "nonlinear zone", "v3", "paper", "diff"));
     for row in &r.table1 {
-        let zone = |z: &crate::paper::ZoneRow| format!("[{:>4.1}, {:>4.1}] ({:>4.1}, {:>4.1})", z.b_int, z.b_ext, z.paper[0], z.paper[1]);
+        let zone = |z: &ZoneRow| format!("[{:>4.1}, {:>4.1}] ({:>4.1}, {:>4.1})", z.b_int, z.b_ext, z.paper[0], z.paper[1]);
         s.push_str(&format!(
             "{:>5.1} | {:<25} {:>8.4} {:>7.3} {:>9} | {:<25} {:>8.4} {:>7.3} {:>9}\n",
             row.p,
@@ -45,18 +44,4 @@ pub fn format_report(r: &PaperReport) -> String {
     let iters: usize = r.table1.iter().map(|x| x.linear.newton_iterations + x.nonlinear.newton_iterations).sum::<usize>() + r.table2.iter().map(|x| x.newton_iterations).sum::<usize>();
     s.push_str(&format!("Newton iterations: {iters} in all; wall time {:.3} s\n", r.seconds));
     s
-}
-
-/// `stamp paper [--json] [--plot DIR]`.
-pub fn paper_command(json: bool, plot: Option<&Path>) -> stamp::Result<()> {
-    let report = run_paper()?;
-    if json {
-        println!("{}", serde_json::to_string_pretty(&report).map_err(|e| stamp::StampError::Problem(e.to_string()))?);
-    } else {
-        print!("{}", format_report(&report));
-    }
-    if let Some(dir) = plot {
-        crate::run::plot_paper_figure4(dir)?;
-    }
-    Ok(())
 }
