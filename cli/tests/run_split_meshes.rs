@@ -98,3 +98,50 @@ fn a_mesh_given_for_the_problem_file_is_named_as_such() {
     assert!(!o.status.success());
     assert!(err.contains("mixed.msh") && err.contains("is a gmsh mesh, not a problem file"), "{err}");
 }
+
+/// Navier's series for the centre deflection of a simply supported square plate (side a) under a
+/// uniform load q: w D / (q a^4) (Timoshenko & Woinowsky-Krieger, eq. 137: 0.00406235).
+fn navier_coefficient() -> f64 {
+    let pi = std::f64::consts::PI;
+    let mut sum = 0.0;
+    for m in (1..400).step_by(2) {
+        for n in (1..400).step_by(2) {
+            let (mf, nf) = (m as f64, n as f64);
+            let sign = if ((m + n) / 2 - 1) % 2 == 0 { 1.0 } else { -1.0 }; // sin(m pi/2) sin(n pi/2)
+            sum += sign / (mf * nf * (mf * mf + nf * nf).powi(2));
+        }
+    }
+    16.0 / pi.powi(6) * sum
+}
+
+/// No shear locking on a cut triangle mesh: a very thin (a/h = 1000) simply supported square plate
+/// under a uniform pressure, linear kinematics, quarter model on gmsh's default triangles, deflects
+/// as Kirchhoff's plate (Navier's series) to the discretisation error; a locking element would be
+/// orders of magnitude too stiff at this slenderness.
+#[test]
+fn a_very_thin_plate_on_cut_triangles_does_not_lock() {
+    let (a, h, e, nu, q): (f64, f64, f64, f64, f64) = (40.0, 0.04, 2.1e5, 0.3, 1e-6);
+    assert!((navier_coefficient() - 0.00406235).abs() < 1e-7, "{}", navier_coefficient());
+    let dir = temp_dir("split-locking");
+    let mesh = repo().join("tests/data/quarter/tri.msh");
+    let text = format!(
+        "[mesh]\nfile = {:?}\n[plate]\nthickness = {h}\nE = {e}\nnu = {nu}\nkinematics = \"linear\"\n\
+         [[boundary]]\ngroup = \"left\"\nfix = [\"symmetry_x1\"]\n[[boundary]]\ngroup = \"bottom\"\nfix = [\"symmetry_x2\"]\n\
+         [[boundary]]\ngroup = \"edge\"\nfix = [\"simply_supported\"]\n\
+         [[load]]\ntype = \"pressure\"\ngroup = \"plate\"\npressure = {q}\nface = \"top\"\n[output]\nvtu = false\nplot = false\n",
+        mesh.display().to_string()
+    );
+    let file = dir.join("thin.toml");
+    std::fs::write(&file, text).unwrap();
+    let out = dir.join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).args(["run", "-q", "--out"]).arg(&out).arg(&file).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let step = s["steps"].as_array().unwrap().last().unwrap().clone();
+    let w = -step["points"]["center"]["displacement"][2].as_f64().unwrap_or_else(|| panic!("{step}"));
+    let d = e * h.powi(3) / (12.0 * (1.0 - nu * nu));
+    let kirchhoff = navier_coefficient() * q * a.powi(4) / d;
+    let err = w / kirchhoff - 1.0;
+    println!("thin plate on cut triangles: w = {w:e}, Kirchhoff {kirchhoff:e} ({:+.3} %)", 100.0 * err);
+    assert!(err.abs() < 0.02, "w = {w:e} against Kirchhoff's {kirchhoff:e} ({:+.2} %)", 100.0 * err);
+}
