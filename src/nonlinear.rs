@@ -3,7 +3,7 @@
 //! cut-back of the load increment (paper eq. 4.13, with the active set updated at every iteration:
 //! the paper's trial-and-error loop, eqs. 4.14-4.15).
 //!
-//! Economies that change the work and not the answer (issue 5; `tests/newton_economy.rs`):
+//! Economies that change the work and not the answer (`tests/newton_economy.rs`):
 //! near the solution a chord step with the last factorisation replaces a new tangent and
 //! factorisation ([`NewtonSettings::chord_tol`]); an iterative linear solver may stop at a
 //! relative residual min(forcing, |R| / force scale) (inexact Newton,

@@ -1,4 +1,4 @@
-//! Issue 5: the fast linear solver (LDL^T of the symmetric part, GMRES on the plate's
+//! The fast linear solver (LDL^T of the symmetric part, GMRES on the plate's
 //! non-symmetric tangent) against the sparse LU, on the real matrices of the sphere problem.
 
 mod common;

@@ -1,4 +1,4 @@
-//! Issue 5: the Newton iteration's economies change the work, not the answer.
+//! The Newton iteration's economies change the work, not the answer.
 //!
 //! - Chord steps (NewtonSettings::chord_tol): near the solution the factorisation of the last
 //!   iterate corrects instead of a new tangent; fewer factorisations, the same converged state.

@@ -1,4 +1,4 @@
-//! Issue 4, verification: robustness of the active set.
+//! Verification of the plate under a sphere: robustness of the active set.
 //!
 //! (a) No cycling. A flat sphere (R = 200 on a 40 x 40 clamped plate, h = 1) pressed 0.5 in one
 //! load increment without line search makes the semi-smooth Newton iteration swing many points in

@@ -1,4 +1,4 @@
-//! Issue 4, verification: mesh convergence of the sphere problem.
+//! Verification of the plate under a sphere: mesh convergence of the sphere problem.
 //!
 //! Clamped square plate a = 40, h = 1, E = 2e5, nu = 0.3, pressed at its centre by a rigid sphere
 //! R = 40 moved 2 (twice the thickness: membrane action), quarter model, automatic eps_reg

@@ -1,4 +1,4 @@
-//! Issue 4, verification: global equilibrium at every converged load step. The punch's force on
+//! Verification of the plate under a sphere: global equilibrium at every converged load step. The punch's force on
 //! the plate, the support reactions (Model::nodal_forces at the prescribed dofs) and the applied
 //! loads add up to zero, in every direction, at every step the solver reports.
 //!

@@ -1,4 +1,4 @@
-//! Issue 4, verification: the small-load limit of the sphere problem against the linear Kirchhoff
+//! Verification of the plate under a sphere: the small-load limit of the sphere problem against the linear Kirchhoff
 //! point-load values for a thin square plate (h/a = 0.01), w = alpha P a^2 / D with
 //! alpha = 0.01160 (simply supported) and 0.00560 (clamped) (Timoshenko & Woinowsky-Krieger, tables
 //! 23 and 62; the series give 0.011601 and 0.005612).

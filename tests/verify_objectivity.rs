@@ -1,4 +1,4 @@
-//! Issue 4, verification: objectivity. The whole problem (mesh, punch and loads) moved by a rigid
+//! Verification of the plate under a sphere: objectivity. The whole problem (mesh, punch and loads) moved by a rigid
 //! motion gives the same answer, moved, to 1e-8 relative.
 //!
 //! The plate's reference surface must lie in the plane (x1, x2) (the mesh is planar and the section

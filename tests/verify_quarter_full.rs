@@ -1,4 +1,4 @@
-//! Issue 4, verification: the quarter model with symmetry conditions and the full model of the
+//! Verification of the plate under a sphere: the quarter model with symmetry conditions and the full model of the
 //! sphere problem agree (centre deflection, contact radius, reaction, every displacement) to 1e-6
 //! relative.
 //!

@@ -1,4 +1,4 @@
-//! Issue 4, verification: unloading. The sphere presses the plate (twice its thickness), then goes
+//! Verification of the plate under a sphere: unloading. The sphere presses the plate (twice its thickness), then goes
 //! back up to where it started (solve_path with targets [0.25, 0.5, 1.0, 0.5, 0.0]). The plate is
 //! elastic and the contact frictionless, so the path does not matter: at 0.5 going down the state
 //! is the one at 0.5 going up, and at 0 the plate is back in its initial state (displacements ~ 0)

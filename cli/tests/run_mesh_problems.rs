@@ -1,4 +1,4 @@
-//! Every problem file of meshes/ that issue 4 added runs through `stamp run`, and its answer passes
+//! The problem files of meshes/ run through `stamp run`, and its answer passes
 //! physical checks: global equilibrium at every converged step (applied load + contact reactions +
 //! support reactions = 0; a force-driven punch's reaction = its force), penetration below the
 //! augmented-Lagrangian tolerance at every step, contact zones that appear and grow, a pressure

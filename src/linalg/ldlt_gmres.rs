@@ -491,8 +491,7 @@ impl LdltGmres {
     }
 }
 
-/// The parallelism of faer's numeric LDL^T, chosen by measurement (issue 5: "faer's parallelism
-/// settings: measure them, do not assume"). With a parallel setting, the first numeric
+/// The parallelism of faer's numeric LDL^T, chosen by measurement, not assumed. With a parallel setting, the first numeric
 /// factorisation of a pattern runs on the threads and the second on one; every later one the way
 /// that was faster. Measured on the 2-core machine with `stamp bench` (2026-11-24): faer's
 /// parallel supernodal factorisation spends its time in scheduling (a third of the samples in

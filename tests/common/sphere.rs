@@ -1,7 +1,7 @@
 //! A square plate pressed at its centre by a rigid sphere, built through the library API the way
 //! the CLI builds it (cli/src/run/build.rs): a mesh, PlateElements, a DofMap with the supports, a
 //! ContactPair of the top-face nodes with a Sphere, solved by NewtonRaphson + SparseLu along a load
-//! path. Used by the verification tests of issue 4.
+//! path. Used by the verification tests (`tests/verify_*.rs`).
 //!
 //! The plate is [-a/2, a/2]^2 (full model) or its quarter [0, a/2]^2 with symmetry conditions on
 //! x1 = 0 and x2 = 0; the node coordinates of the quarter are bit for bit those of the full model's
