@@ -4,14 +4,10 @@
 
 mod common;
 use common::*;
-use stamp::dofs::DofMap;
 use stamp::element::{Element, LocalSystem};
 use stamp::io::gmsh::{read_msh, GmshMesh};
-use stamp::linalg::linear_solver::SparseLu;
 use stamp::mesh::{quad_signed_area, QuadMesh};
-use stamp::model::Model;
-use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver};
-use stamp_elements::{Face, Kinematics, PlateElements};
+use stamp_elements::Kinematics;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -240,36 +236,9 @@ fn rigid_body_motions_are_exact_on_a_cut_triangle_mesh() {
 /// Solves with the boundary nodes prescribed to `exact`; the largest error at the interior nodes
 /// relative to the largest exact value.
 fn patch(m: &QuadMesh, kin: Kinematics, h: f64, exact: &dyn Fn([f64; 2], f64) -> [f64; 3]) -> f64 {
-    let section = steel_section(h);
-    let (dm, dp) = (section.delta_minus, section.delta_plus);
-    let plate = PlateElements::new(m, section, kin).unwrap();
-    let mut dofs = DofMap::new(m.num_nodes(), 6).unwrap();
     let boundary = boundary_nodes(m);
-    for &n in &boundary {
-        for (face, z) in [(Face::Bottom, dm), (Face::Top, dp)] {
-            let v = exact(m.coords[n], z);
-            for c in 0..3 {
-                dofs.prescribe(n, face.index() * 3 + c, v[c]).unwrap();
-            }
-        }
-    }
-    let mut model = Model::new(plate, dofs).unwrap();
-    let mut newton = NewtonRaphson::new(SparseLu::new(), NewtonSettings::default());
-    let mut u = vec![0.0; model.dofs.num_dofs()];
-    newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
-    let (mut err, mut scale) = (0.0f64, 0.0f64);
-    let interior: Vec<usize> = (0..m.num_nodes()).filter(|n| boundary.binary_search(n).is_err()).collect();
-    assert!(interior.len() > 10);
-    for n in interior {
-        for (face, z) in [(Face::Bottom, dm), (Face::Top, dp)] {
-            let v = exact(m.coords[n], z);
-            for c in 0..3 {
-                err = err.max((u[face.dof(n, c)] - v[c]).abs());
-                scale = scale.max(v[c].abs());
-            }
-        }
-    }
-    err / scale
+    assert!(m.num_nodes() - boundary.len() > 10);
+    patch_error(m, &boundary, kin, h, exact)
 }
 
 #[test]

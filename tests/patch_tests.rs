@@ -7,12 +7,8 @@
 
 mod common;
 use common::*;
-use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
-use stamp::linalg::linear_solver::SparseLu;
-use stamp::model::Model;
-use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver};
-use stamp_elements::{Face, Kinematics, PlateElements};
+use stamp_elements::Kinematics;
 
 fn five_element_patch() -> QuadMesh {
     let coords = vec![
@@ -26,35 +22,7 @@ fn five_element_patch() -> QuadMesh {
 /// Solve the patch with the four outer nodes prescribed to `exact(node, face) -> [v1, v2, v3]`;
 /// return the largest error at the interior nodes relative to the largest exact value.
 fn patch(kin: Kinematics, h: f64, exact: &dyn Fn([f64; 2], f64) -> [f64; 3]) -> f64 {
-    let mesh = five_element_patch();
-    let section = steel_section(h);
-    let (dm, dp) = (section.delta_minus, section.delta_plus);
-    let plate = PlateElements::new(&mesh, section, kin).unwrap();
-    let mut dofs = DofMap::new(mesh.num_nodes(), 6).unwrap();
-    for n in 0..4 {
-        for (face, z) in [(Face::Bottom, dm), (Face::Top, dp)] {
-            let v = exact(mesh.coords[n], z);
-            for c in 0..3 {
-                dofs.prescribe(n, face.index() * 3 + c, v[c]).unwrap();
-            }
-        }
-    }
-    let mut model = Model::new(plate, dofs).unwrap();
-    let mut newton = NewtonRaphson::new(SparseLu::new(), NewtonSettings::default());
-    let mut u = vec![0.0; model.dofs.num_dofs()];
-    newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
-    let mut err: f64 = 0.0;
-    let mut scale: f64 = 0.0;
-    for n in 4..8 {
-        for (face, z) in [(Face::Bottom, dm), (Face::Top, dp)] {
-            let v = exact(mesh.coords[n], z);
-            for c in 0..3 {
-                err = err.max((u[face.dof(n, c)] - v[c]).abs());
-                scale = scale.max(v[c].abs());
-            }
-        }
-    }
-    err / scale
+    patch_error(&five_element_patch(), &[0, 1, 2, 3], kin, h, exact)
 }
 
 fn homogeneous(g: [[f64; 3]; 3]) -> impl Fn([f64; 2], f64) -> [f64; 3] {

@@ -11,26 +11,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// A cantilever strip on the built-in rectangle (fast to solve: 4 steps).
-const BASE: &str = r#"title = "cantilever"
-[mesh]
-rectangle = { x = [0.0, 1.0], y = [0.0, 100.0], n = [1, 40] }
-
-[plate]
-thickness = 2.0
-E = 2.0e4
-nu = 0.3
-kinematics = "linear"
-plane_strain = true
-
-[[boundary]]
-group = "bottom"
-fix = ["clamped"]
-
-[[load]]
-type = "line"
-group = "top"
-force = [0.0, 0.0, 0.05]
-"#;
+const BASE: &str = CANTILEVER;
 
 /// A cylinder punch above the strip, for the punch keys.
 const PUNCH: &str = "\n[[punch]]\nname = \"roller\"\nshape = \"cylinder\"\npoint = [0.0, 50.0, 5.0]\naxis = [1.0, 0.0, 0.0]\nradius = 4.0\nmotion = [0.0, 0.0, -1.0]\n";

@@ -8,28 +8,6 @@ use std::path::PathBuf;
 use std::process::Command;
 use stamp_cli::run::{build::build, Problem};
 
-/// A cantilever strip (Table 1's first row): plane strain, clamped at x2 = 0, an end force F per
-/// unit width at x2 = 100, no punch.
-const CANTILEVER: &str = r#"title = "cantilever"
-[mesh]
-rectangle = { x = [0.0, 1.0], y = [0.0, 100.0], n = [1, 40] }
-
-[plate]
-thickness = 2.0
-E = 2.0e4
-nu = 0.3
-kinematics = "linear"
-plane_strain = true
-
-[[boundary]]
-group = "bottom"
-fix = ["clamped"]
-
-[[load]]
-type = "line"
-group = "top"
-force = [0.0, 0.0, 0.05]
-"#;
 
 fn write(dir: &PathBuf, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);

@@ -94,3 +94,38 @@ pub fn bending_stiffness(h: f64) -> f64 {
 }
 
 pub mod sphere;
+
+/// A patch test: solves the plate on `mesh` with the nodes `boundary` (both faces) prescribed to
+/// `exact(x, x3) -> [v1, v2, v3]` and returns the largest error at the other nodes relative to the
+/// largest exact value there.
+pub fn patch_error(mesh: &QuadMesh, boundary: &[usize], kin: Kinematics, h: f64, exact: &dyn Fn([f64; 2], f64) -> [f64; 3]) -> f64 {
+    use stamp::nonlinear::NonlinearSolver;
+    use stamp_elements::Face;
+    let section = steel_section(h);
+    let (dm, dp) = (section.delta_minus, section.delta_plus);
+    let plate = PlateElements::new(mesh, section, kin).unwrap();
+    let mut dofs = stamp::dofs::DofMap::new(mesh.num_nodes(), 6).unwrap();
+    for &n in boundary {
+        for (face, z) in [(Face::Bottom, dm), (Face::Top, dp)] {
+            let v = exact(mesh.coords[n], z);
+            for c in 0..3 {
+                dofs.prescribe(n, face.index() * 3 + c, v[c]).unwrap();
+            }
+        }
+    }
+    let mut model = stamp::model::Model::new(plate, dofs).unwrap();
+    let mut newton = stamp::nonlinear::NewtonRaphson::new(stamp::linalg::linear_solver::SparseLu::new(), stamp::nonlinear::NewtonSettings::default());
+    let mut u = vec![0.0; model.dofs.num_dofs()];
+    newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
+    let (mut err, mut scale) = (0.0f64, 0.0f64);
+    for n in (0..mesh.num_nodes()).filter(|n| !boundary.contains(n)) {
+        for (face, z) in [(Face::Bottom, dm), (Face::Top, dp)] {
+            let v = exact(mesh.coords[n], z);
+            for c in 0..3 {
+                err = err.max((u[face.dof(n, c)] - v[c]).abs());
+                scale = scale.max(v[c].abs());
+            }
+        }
+    }
+    err / scale
+}
