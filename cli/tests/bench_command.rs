@@ -71,7 +71,11 @@ fn bench_with_reuse_gives_the_same_answer_with_fewer_factorisations() {
     assert_eq!(ls(&plain, "preconditioned"), plain["factorizations"].as_u64().unwrap(), "{plain}");
     assert!(ls(&reuse, "reused") > 0, "{reuse}");
     assert!(reuse["factorizations"].as_u64().unwrap() < plain["factorizations"].as_u64().unwrap(), "{plain}\n{reuse}");
-    assert_eq!(plain["newton_iterations"], reuse["newton_iterations"]);
+    // reuse is decided by measured times (a reused preconditioner while it is cheaper than a new
+    // factorisation), so on a loaded machine the inexact solves may differ and cost an iteration:
+    // the answer must be the same, the iterations about the same
+    let (ni, nr) = (plain["newton_iterations"].as_i64().unwrap(), reuse["newton_iterations"].as_i64().unwrap());
+    assert!((ni - nr).abs() <= 2, "Newton iterations {ni} without reuse, {nr} with");
     for k in ["centre_deflection", "reaction"] {
         assert!((f(&plain, k) / f(&reuse, k) - 1.0).abs() < 1e-8, "{k}: {plain}\n{reuse}");
     }
