@@ -1,5 +1,7 @@
-//! A model: one element set on a mesh, its dofs and constraints, nodal loads and punches. It is the
-//! [`NonlinearProblem`] the solver drives: R(u, t) = f_int(u) + f_contact(u, t) - t f_ext.
+//! A model: one element set on a mesh, its dofs and constraints, nodal loads, displacement-dependent
+//! loads and punches. It is the [`NonlinearProblem`] the solver drives:
+//! R(u, t) = f_int(u) + f_contact(u, t) - t f_ext - t F(u), F the
+//! [`crate::follower::DeformationDependentLoad`]s (follower pressures, say).
 //!
 //! The unknowns are the nodal dofs (node-major, as in [`DofMap`]) followed by one displacement per
 //! force-driven punch (see [`crate::contact::ForceDrive`]), in the order of `contacts`; so are the
