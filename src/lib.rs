@@ -19,5 +19,6 @@ pub mod element;
 pub mod linalg;
 pub mod assembly;
 pub mod contact;
+pub mod follower;
 pub mod model;
 pub mod nonlinear;

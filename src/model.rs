@@ -1,5 +1,7 @@
-//! A model: one element set on a mesh, its dofs and constraints, nodal loads and punches. It is the
-//! [`NonlinearProblem`] the solver drives: R(u, t) = f_int(u) + f_contact(u, t) - t f_ext.
+//! A model: one element set on a mesh, its dofs and constraints, nodal loads, displacement-dependent
+//! loads and punches. It is the [`NonlinearProblem`] the solver drives:
+//! R(u, t) = f_int(u) + f_contact(u, t) - t f_ext - t F(u), F the
+//! [`crate::follower::DeformationDependentLoad`]s (follower pressures, say).
 //!
 //! The unknowns are the nodal dofs (node-major, as in [`DofMap`]) followed by one displacement per
 //! force-driven punch (see [`crate::contact::ForceDrive`]), in the order of `contacts`; so are the
@@ -11,6 +13,7 @@ use crate::assembly::Assembler;
 use crate::contact::{ContactPair, PointState};
 use crate::dofs::DofMap;
 use crate::element::Element;
+use crate::follower::DeformationDependentLoad;
 use crate::error::{Result, StampError};
 use crate::nonlinear::{Evaluation, NonlinearProblem};
 use crate::linalg::sparse::SparsePattern;
@@ -32,6 +35,12 @@ pub struct Model<E: Element> {
     /// Nodal forces (dof, value at load factor 1).
     pub loads: Vec<(usize, f64)>,
     pub contacts: Vec<ContactPair>,
+    /// Displacement-dependent loads (follower pressures, couples), at load factor 1, scaled by
+    /// the load factor like `loads`.
+    pub follower_loads: Vec<Box<dyn DeformationDependentLoad>>,
+    /// The displacement-dependent loads' force over all nodal dofs at the last evaluation (at the
+    /// evaluation's load factor).
+    follower_force: Vec<f64>,
     /// Augmented-Lagrangian tolerance on the penetration (a length; see
     /// [`ContactPair::constraint_violation`]); `None` for the plain perturbed Lagrangian.
     pub augmented_tolerance: Option<f64>,
@@ -83,6 +92,8 @@ impl<E: Element> Model<E> {
             dofs,
             loads: Vec::new(),
             contacts: Vec::new(),
+            follower_loads: Vec::new(),
+            follower_force: Vec::new(),
             augmented_tolerance: None,
             nodal_pattern: None,
             pattern,
@@ -110,6 +121,18 @@ impl<E: Element> Model<E> {
     /// on the body.
     pub fn nodal_forces(&self) -> &[f64] {
         &self.force[..self.dofs.num_dofs()]
+    }
+
+    /// Add a displacement-dependent load (at load factor 1).
+    pub fn add_follower_load(&mut self, load: Box<dyn DeformationDependentLoad>) {
+        self.follower_loads.push(load);
+    }
+
+    /// The displacement-dependent loads' force over all nodal dofs at the last evaluation, at its
+    /// load factor (empty when there are none): the external force they apply, including at
+    /// prescribed dofs, where [`Model::nodal_forces`] does not count it.
+    pub fn follower_forces(&self) -> &[f64] {
+        &self.follower_force
     }
 
     /// Add a punch; a force-driven one gets its unknown (after the nodal dofs and the earlier
@@ -230,8 +253,41 @@ impl<E: Element> NonlinearProblem for Model<E> {
                 }
             }
         }
+        if !self.follower_loads.is_empty() {
+            self.follower_force.clear();
+            self.follower_force.resize(nd, 0.0);
+            let pattern = &self.pattern;
+            let dofs = &self.dofs;
+            let values = &mut self.values;
+            // R gets -t F, K gets -t dF/du (not symmetric: kept out of the preconditioner)
+            let mut add = |r: usize, c: usize, v: f64| {
+                if let (Some(re), Some(ce)) = (dofs.equation(r), dofs.equation(c)) {
+                    if let Some(s) = pattern.find(re, ce) {
+                        values[s] -= t * v;
+                    }
+                }
+            };
+            for load in &self.follower_loads {
+                if with_tangent {
+                    load.add_force_and_stiffness(&u[..nd], &mut self.follower_force, Some(&mut add));
+                } else {
+                    load.add_force_and_stiffness(&u[..nd], &mut self.follower_force, None);
+                }
+            }
+            for f in self.follower_force.iter_mut() {
+                *f *= t;
+            }
+            ext_sq += self.follower_force.iter().map(|x| x * x).sum::<f64>();
+        }
         self.timings.contact += t_contact.elapsed().as_secs_f64();
         self.dofs.gather(&self.force[..nd], &mut self.residual[..neq]);
+        for (d, &f) in self.follower_force.iter().enumerate() {
+            if f != 0.0 {
+                if let Some(e) = self.dofs.equation(d) {
+                    self.residual[e] -= f;
+                }
+            }
+        }
         for k in 0..self.border.len() {
             self.residual[neq + k] = self.force[nd + k];
         }

@@ -6,10 +6,12 @@
 //! rigid-body motion exactly, discretised by the mixed (Hu-Washizu) four-node element of the paper.
 //! It plugs into the stamp framework as an [`stamp::element::Element`].
 
+pub mod follower;
 pub mod geometry;
 pub mod material;
 pub mod plate;
 pub mod strain;
 
+pub use follower::{fixed_couple_force, FollowerCouple, FollowerPressure};
 pub use material::{Isotropic, Layer, Section};
 pub use plate::{Face, Kinematics, PlateElements, DOFS_PER_NODE};

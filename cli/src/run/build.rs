@@ -6,7 +6,12 @@
 //!   rotations are free; in-plane motions must be restrained by other conditions), `clamped` all
 //!   six, `symmetry_x1` v1- and v1+ (a symmetry plane with normal x1), `symmetry_x2` v2- and v2+.
 //!   `plate.plane_strain = true` holds v1- = v1+ = 0 at every node.
-//! * Loads are dead loads (fixed direction, reference geometry), scaled by the load factor.
+//! * Loads are dead loads (fixed direction, reference geometry), scaled by the load factor, except
+//!   `follower = true` ones (see `stamp_elements::follower`): a follower pressure acts normal to
+//!   the deformed face on its deformed area; a `moment` (couple per unit length m along a curve
+//!   group, node shares as for `line`) is a force pair on each node's two face points,
+//!   f+ = (M x d) / |d|^2, f- = -f+, d the current fibre (follower) or the reference one h e3
+//!   (fixed, dead forces).
 //!   `line`: force per unit length along a curve group, each segment of length L gives F L / 2 to
 //!   each end node; `surface`: force per unit area, `pressure`: p > 0 pushes on the face towards the
 //!   plate (-x3 on the top face, +x3 on the bottom face), both with the consistent nodal weights
@@ -35,7 +40,7 @@ use stamp::nonlinear::NewtonSettings;
 use stamp::surface::ContactSurface;
 use stamp::{Result, StampError};
 use stamp_contact::{Cylinder, Plane, Sphere};
-use stamp_elements::{Face, Isotropic, Kinematics, PlateElements, Section};
+use stamp_elements::{fixed_couple_force, Face, FollowerCouple, FollowerPressure, Isotropic, Kinematics, PlateElements, Section};
 use std::sync::Arc;
 
 /// Factor c of the automatic eps_reg (see the module notes).
@@ -196,6 +201,16 @@ pub fn build(p: &Problem) -> Result<Setup> {
             }
             LoadKind::Surface | LoadKind::Pressure => {
                 let cells = mesh.surfaces.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "surface", &mesh))?;
+                if ls.kind == LoadKind::Pressure && ls.follower {
+                    let (f, z) = match face {
+                        LoadFace::Top => (Face::Top, section.delta_plus),
+                        _ => (Face::Bottom, section.delta_minus),
+                    };
+                    let quads: Vec<[usize; 4]> = cells.iter().map(|&c| mesh.mesh.cells[c]).collect();
+                    let what = format!("follower pressure on '{}'", stamp::quote(name));
+                    model.add_follower_load(Box::new(FollowerPressure::new(what, &mesh.mesh.coords, &quads, f, z, ls.pressure.unwrap().0)));
+                    continue;
+                }
                 let f = match ls.kind {
                     LoadKind::Surface => ls.force.unwrap().0,
                     _ => {
@@ -207,6 +222,30 @@ pub fn build(p: &Problem) -> Result<Setup> {
                 for (n, &a) in w.iter().enumerate() {
                     if a > 0.0 {
                         add_force(&mut model, n, f.map(|x| a * x), face)?;
+                    }
+                }
+            }
+            LoadKind::Moment => {
+                let segs = mesh.curves.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "curve", &mesh))?;
+                let m = ls.moment.unwrap().0;
+                let mut share = vec![0.0; n_nodes];
+                for s in segs {
+                    let (a, b) = (mesh.mesh.coords[s[0]], mesh.mesh.coords[s[1]]);
+                    let len = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                    for &n in s {
+                        share[n] += 0.5 * len;
+                    }
+                }
+                let h = section.thickness();
+                let couples: Vec<(usize, [f64; 3])> = share.iter().enumerate().filter(|(_, &w)| w > 0.0).map(|(n, &w)| (n, m.map(|x| w * x))).collect();
+                if ls.follower {
+                    let what = format!("follower couple on '{}'", stamp::quote(name));
+                    model.add_follower_load(Box::new(FollowerCouple::new(what, couples, h)));
+                } else {
+                    for (n, mn) in couples {
+                        let f = fixed_couple_force(mn, h);
+                        add_force(&mut model, n, f, LoadFace::Top)?;
+                        add_force(&mut model, n, f.map(|x| -x), LoadFace::Bottom)?;
                     }
                 }
             }

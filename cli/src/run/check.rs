@@ -119,9 +119,10 @@ fn check_groups(p: &Problem, mesh: &MeshData) -> Result<()> {
         let (g, key) = (&ls.group, format!("load[{i}].group"));
         let name = g.get_ref();
         match ls.kind {
-            LoadKind::Line => {
+            LoadKind::Line | LoadKind::Moment => {
                 if mesh.curves.get(name).is_some_and(|c| c.is_empty()) {
-                    return Err(empty(g.span(), &key, name, "has no edges (2-node lines): a line load acts along the edges of a curve group"));
+                    let kind = if ls.kind == LoadKind::Moment { "moment" } else { "line load" };
+                    return Err(empty(g.span(), &key, name, &format!("has no edges (2-node lines): a {kind} acts along the edges of a curve group")));
                 }
             }
             LoadKind::Surface | LoadKind::Pressure => {
@@ -357,6 +358,8 @@ fn load_total(p: &Problem, mesh: &MeshData, i: usize) -> [f64; 3] {
             let q = ls.pressure.unwrap().0;
             [0.0, 0.0, if ls.face == Some(LoadFace::Top) { -q * a } else { q * a }]
         }
+        // a couple: force pairs without resultant
+        LoadKind::Moment => [0.0; 3],
         LoadKind::Point => {
             let n = mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).map(|v| v.len()).unwrap_or(0);
             ls.force.unwrap().0.map(|f| f * n as f64)
@@ -476,7 +479,13 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
             }
             let kind = format!("{:?}", ls.kind).to_lowercase();
             let face = format!("{:?}", ls.face.unwrap_or_default()).to_lowercase();
-            let _ = writeln!(o, "  load[{i}]: {kind} on '{}', face {face}: total force {}", quote(ls.group.get_ref()), vec3(t));
+            let follows = if ls.follower { " (follower: in the reference state)" } else { "" };
+            if ls.kind == LoadKind::Moment {
+                let m = ls.moment.map(|m| m.0).unwrap_or([0.0; 3]);
+                let _ = writeln!(o, "  load[{i}]: moment on '{}', per unit length {}{follows}: total force 0", quote(ls.group.get_ref()), vec3(m));
+            } else {
+                let _ = writeln!(o, "  load[{i}]: {kind} on '{}', face {face}: total force {}{follows}", quote(ls.group.get_ref()), vec3(t));
+            }
         }
         let _ = writeln!(o, "  all loads: total force {}", vec3(sum));
     }

@@ -103,7 +103,8 @@ pub struct StepEntry {
     pub reaction: [f64; 3],
     /// Total force of the supports (the prescribed dofs) on the plate.
     pub support_reaction: [f64; 3],
-    /// Total applied load (nodal loads times the load factor). In equilibrium
+    /// Total applied load (nodal loads times the load factor, and the follower loads in the
+    /// deformed state). In equilibrium
     /// applied_load + reaction + support_reaction = 0.
     pub applied_load: [f64; 3],
     pub max_penetration: f64,
@@ -326,6 +327,13 @@ pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, 
         applied[(d % dpn) % 3] += t * v;
         if model.dofs.equation(d).is_none() {
             support[(d % dpn) % 3] -= t * v;
+        }
+    }
+    // follower loads (pressures, couples): their force at the last evaluation, already times t
+    for (d, &f) in model.follower_forces().iter().enumerate() {
+        applied[(d % dpn) % 3] += f;
+        if model.dofs.equation(d).is_none() {
+            support[(d % dpn) % 3] -= f;
         }
     }
     let entry = StepEntry {

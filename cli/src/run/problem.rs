@@ -407,6 +407,8 @@ pub enum LoadKind {
     Surface,
     /// Force at every node of a point group.
     Point,
+    /// Couple per unit length along a curve group, carried by the two faces.
+    Moment,
 }
 
 /// Where a load acts through the thickness.
@@ -434,6 +436,12 @@ pub struct LoadSpec {
     pub pressure: Option<Finite>,
     #[serde(default)]
     pub face: Option<LoadFace>,
+    /// moment: couple per unit length [m1, m2, m3] at load factor 1 (right-hand rule).
+    #[serde(default)]
+    pub moment: Option<Vec3>,
+    /// pressure, moment: the load follows the deformation (default false: a dead load).
+    #[serde(default)]
+    pub follower: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -799,11 +807,32 @@ impl Problem {
                         return Err(self.error_at(l.span(), &format!("{key}.face"), "a pressure acts on face = \"top\" or \"bottom\""));
                     }
                 }
-                _ => {
-                    if ls.force.is_none() || ls.pressure.is_some() {
-                        return Err(self.error_at(l.span(), &key, "a line, surface or point load needs `force` (and no `pressure`)"));
+                LoadKind::Moment => {
+                    let Some(m) = ls.moment else {
+                        return Err(self.error_at(l.span(), &key, "a moment load needs `moment` = [m1, m2, m3] (a couple per unit length)"));
+                    };
+                    if ls.force.is_some() || ls.pressure.is_some() || ls.face.is_some() {
+                        return Err(self.error_at(l.span(), &key, "a moment load takes `moment` (and no `force`, `pressure` or `face`: it acts through both faces)"));
+                    }
+                    if !ls.follower && m.0[2] != 0.0 {
+                        return Err(self.error_at(
+                            l.span(),
+                            &format!("{key}.moment"),
+                            format!("a fixed couple (follower = false) cannot twist about the plate's normal: m3 must be 0, got {}", num(m.0[2])),
+                        ));
                     }
                 }
+                _ => {
+                    if ls.force.is_none() || ls.pressure.is_some() || ls.moment.is_some() {
+                        return Err(self.error_at(l.span(), &key, "a line, surface or point load needs `force` (and no `pressure` or `moment`)"));
+                    }
+                    if ls.follower {
+                        return Err(self.error_at(l.span(), &format!("{key}.follower"), "only a pressure or a moment load can follow the deformation"));
+                    }
+                }
+            }
+            if ls.kind == LoadKind::Pressure && ls.moment.is_some() {
+                return Err(self.error_at(l.span(), &key, "a pressure load takes no `moment`"));
             }
         }
         let mut names = std::collections::BTreeSet::new();
