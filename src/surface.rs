@@ -35,6 +35,14 @@ pub trait ContactSurface: Send + Sync {
     fn describe(&self) -> String {
         "user-defined surface".to_string()
     }
+
+    /// Why an evaluation of Psi, its gradient or Hessian was not finite, if one was: a surface
+    /// that can fail (an expression's sqrt of a negative number) returns NaN, which the contact
+    /// code would treat as "no contact", and keeps the first failure here. The caller checks it
+    /// after a solve (or a step) and stops with this message. Default: None (never fails).
+    fn evaluation_error(&self) -> Option<String> {
+        None
+    }
 }
 
 /// Central-difference Hessian of a surface's analytic gradient, symmetrised. This is the default of

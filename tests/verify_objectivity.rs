@@ -77,7 +77,7 @@ fn model(mesh: &QuadMesh, sphere: Sphere, motion: [f64; 3], load: [f64; 3]) -> M
         .collect();
     let eps = 100.0 * YOUNG * H / ((40.0 / M as f64).powi(2) * (2.0 * RADIUS).powi(2));
     let mut pair = ContactPair::new("sphere", Arc::new(sphere), points, eps, ContactKinematics::Exact);
-    pair.motion = motion;
+    pair.motion = motion.into();
     model.contacts.push(pair);
     model
 }

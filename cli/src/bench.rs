@@ -94,7 +94,7 @@ fn build(n: usize) -> Result<Model<PlateElements>> {
     let grad = 2.0 * RADIUS;
     let eps_reg = 100.0 * YOUNG * THICKNESS / (le * le * grad * grad);
     let mut pair = ContactPair::new("sphere", sphere, points, eps_reg, ContactKinematics::Exact);
-    pair.motion = [0.0, 0.0, -PUNCH_TRAVEL];
+    pair.motion = [0.0, 0.0, -PUNCH_TRAVEL].into();
     model.contacts.push(pair);
     Ok(model)
 }

@@ -1,7 +1,8 @@
 //! # stamp-contact — rigid punch shapes
 //!
 //! Implementations of [`stamp::surface::ContactSurface`] for the punches of the paper: a
-//! [`Cylinder`] (eq. 3.6), a [`Sphere`] and a [`Plane`]. Each surface is an implicit function
+//! [`Cylinder`] (eq. 3.6), a [`Sphere`], a [`Plane`], and an [`Expression`]: Psi written by the
+//! user in x1, x2, x3, differentiated exactly by forward-mode automatic differentiation. Each surface is an implicit function
 //! Psi(x) that is negative inside the punch, zero on its surface and positive outside, with its
 //! analytic gradient and Hessian.
 //!
@@ -10,10 +11,14 @@
 //! [`StampError::Problem`] instead of panicking.
 
 mod cylinder;
+mod expression;
+pub mod expression_parser;
+pub mod jet;
 mod plane;
 mod sphere;
 
 pub use cylinder::Cylinder;
+pub use expression::Expression;
 pub use plane::Plane;
 pub use sphere::Sphere;
 

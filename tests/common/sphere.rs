@@ -192,7 +192,7 @@ impl SphereProblem {
             Kinematics::Linear => ContactKinematics::Shallow { direction: [0.0, 0.0, 1.0] },
         };
         let mut pair = ContactPair::new("sphere", Arc::new(self.sphere()), points, self.eps(), ck);
-        pair.motion = [0.0, 0.0, -self.depth];
+        pair.motion = [0.0, 0.0, -self.depth].into();
         pair
     }
 

@@ -39,7 +39,7 @@ use stamp::model::Model;
 use stamp::nonlinear::NewtonSettings;
 use stamp::surface::ContactSurface;
 use stamp::{Result, StampError};
-use stamp_contact::{Cylinder, Plane, Sphere};
+use stamp_contact::{Cylinder, Expression, Plane, Sphere};
 use stamp_elements::{fixed_couple_force, Face, FollowerCouple, FollowerPressure, Isotropic, Kinematics, PlateElements, Section};
 use std::sync::Arc;
 
@@ -273,6 +273,10 @@ pub fn build(p: &Problem) -> Result<Setup> {
             Shape::Cylinder => Arc::new(Cylinder::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.axis.unwrap().0), spec.radius.unwrap().0).map_err(wrap)?),
             Shape::Sphere => Arc::new(Sphere::new(Vector3::from(spec.center.unwrap().0), spec.radius.unwrap().0).map_err(wrap)?),
             Shape::Plane => Arc::new(Plane::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.normal.unwrap().0)).map_err(wrap)?),
+            Shape::Expression => {
+                let psi = spec.psi.as_ref().unwrap();
+                Arc::new(Expression::new(psi.get_ref(), model_size(&mesh, &section, None)).map_err(|e| p.psi_error(psi, e.column, &format!("{key}.psi"), &e.message))?)
+            }
         };
         let face = face_of(spec.face);
         let z = match face {
@@ -312,7 +316,17 @@ pub fn build(p: &Problem) -> Result<Setup> {
             None => (automatic_eps_reg(young * h, le, pair.contact_gradient_norm()), true),
         };
         pair.eps_reg = eps_reg;
-        pair.motion = spec.motion.map(|m| m.0).unwrap_or([0.0; 3]);
+        pair.motion = spec.motion.as_ref().map(|m| m.0.clone()).unwrap_or_default();
+        // an expression must be finite (and smooth) at every candidate point where the punch starts
+        if let Some(psi) = &spec.psi {
+            for q in &pair.points {
+                let x = Vector3::from(q.x_ref);
+                let _ = (surface.psi(&x), surface.hessian(&x));
+            }
+            if let Some(m) = surface.evaluation_error() {
+                return Err(p.error_at(psi.span(), &format!("{key}.psi"), m));
+            }
+        }
         if let Some(f) = spec.force {
             let dir = spec.direction.map(|d| d.0).unwrap_or(match face {
                 Face::Top => [0.0, 0.0, -1.0],

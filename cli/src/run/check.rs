@@ -298,7 +298,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
         // on the face's side: else the warning above says what is wrong)
         let (push, what) = match &pair.drive {
             Some(f) => (Vector3::from(f.direction) * f.force, format!("its force {} along {}", num(f.force), vec3(f.direction))),
-            None => (Vector3::from(pair.motion), format!("its motion {}", vec3(pair.motion))),
+            None => (Vector3::from(pair.motion.approach()), format!("its {}", motion_words(&pair.motion))),
         };
         if !wrong_side && push.norm() > 0.0 && push.dot(&n_face) > 1e-9 * push.norm() {
             out.push(format!("{head}: {what} moves it away from its contact face ({face}, outward normal {sign}x3): it will not press the plate"));
@@ -495,7 +495,7 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
     for (i, ((info, pair), st)) in setup.punches.iter().zip(&setup.model.contacts).zip(starts).enumerate() {
         let drive = match &pair.drive {
             Some(f) => format!("driven by force {} along {}", num(f.force), vec3(f.direction)),
-            None => format!("driven by motion {}", vec3(pair.motion)),
+            None => format!("driven by {}", motion_words(&pair.motion)),
         };
         let gap = match &st.first {
             Some(f) => format!(
@@ -520,4 +520,15 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
     let targets = &setup.targets;
     let _ = write!(o, "load factors: {} target{} up to {}", targets.len(), if targets.len() == 1 { "" } else { "s" }, num(targets.iter().cloned().fold(0.0, f64::max)));
     o
+}
+
+/// "motion [..]" or "path of N points (approach [..], last displacement [..] at t = ..)".
+fn motion_words(m: &stamp::contact::PunchMotion) -> String {
+    match m {
+        stamp::contact::PunchMotion::Linear(v) => format!("motion {}", vec3(*v)),
+        stamp::contact::PunchMotion::Path(points) => {
+            let (t, last) = points.last().copied().unwrap_or((0.0, [0.0; 3]));
+            format!("path of {} points (approach {}, last displacement {} from t = {})", points.len(), vec3(m.approach()), vec3(last), num(t))
+        }
+    }
 }

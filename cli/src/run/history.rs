@@ -46,7 +46,7 @@ pub fn punch_direction(pair: &ContactPair, face: Face) -> [f64; 3] {
     if let Some(d) = &pair.drive {
         return d.direction;
     }
-    let m = pair.motion;
+    let m = pair.motion.approach();
     let norm = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
     if norm > 0.0 {
         return m.map(|x| x / norm);

@@ -85,6 +85,8 @@ pub mod limits {
     pub const MAX_CELLS_PER_SIDE: u64 = 1_000_000;
     /// Characters of a punch name (it names output files).
     pub const MAX_NAME_CHARS: usize = 64;
+    /// The most rows of a punch's motion path.
+    pub const MAX_PATH_ROWS: usize = 10_000;
     /// Bytes of a problem file.
     pub const MAX_FILE_BYTES: u64 = 1 << 20;
     /// Smallest penetration tolerance relative to the model size (largest coordinate, thickness
@@ -152,6 +154,45 @@ impl<'de> Deserialize<'de> for Vec3 {
             Ok(Vec3(v))
         } else {
             Err(D::Error::custom(format!("expected three finite numbers of magnitude at most 1e100, got {}", vec_text(&v))))
+        }
+    }
+}
+
+/// A punch's prescribed motion: `[d1, d2, d3]` (the displacement at load factor 1, times the load
+/// factor) or rows `[[t, d1, d2, d3], ...]`, a path piecewise linear in the load factor (checked by
+/// [`stamp::contact::PunchMotion::path`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionSpec(pub stamp::contact::PunchMotion);
+impl<'de> Deserialize<'de> for MotionSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Linear(Vec<f64>),
+            Path(Vec<Vec<f64>>),
+        }
+        const FORMS: &str = "expected [d1, d2, d3] (the displacement at load factor 1) or rows [[t, d1, d2, d3], ...] (a path in the load factor t)";
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() <= limits::MAX_MAGNITUDE);
+        match Raw::deserialize(d).map_err(|_| D::Error::custom(FORMS))? {
+            Raw::Linear(v) if v.len() == 3 && finite(&v) => Ok(MotionSpec(stamp::contact::PunchMotion::Linear([v[0], v[1], v[2]]))),
+            Raw::Linear(v) if v.len() == 3 => Err(D::Error::custom(format!("expected three finite numbers of magnitude at most 1e100, got {}", vec_text(&v)))),
+            Raw::Linear(v) => Err(D::Error::custom(format!("{FORMS}, got {} numbers", v.len()))),
+            Raw::Path(rows) => {
+                if rows.len() > limits::MAX_PATH_ROWS {
+                    return Err(D::Error::custom(format!("a path has at most {} rows, got {}", limits::MAX_PATH_ROWS, rows.len())));
+                }
+                let mut path = Vec::with_capacity(rows.len());
+                for (k, r) in rows.iter().enumerate() {
+                    if r.len() != 4 {
+                        return Err(D::Error::custom(format!("path row {k}: expected [t, d1, d2, d3], got {} numbers", r.len())));
+                    }
+                    if !finite(r) {
+                        return Err(D::Error::custom(format!("path row {k}: expected finite numbers of magnitude at most 1e100, got {}", vec_text(r))));
+                    }
+                    path.push((r[0], [r[1], r[2], r[3]]));
+                }
+                stamp::contact::PunchMotion::path(&path).map(MotionSpec).map_err(|e| D::Error::custom(format!("path {e}")))
+            }
         }
     }
 }
@@ -450,6 +491,8 @@ pub enum Shape {
     Cylinder,
     Sphere,
     Plane,
+    /// Psi written as an expression in x1, x2, x3 (`psi`).
+    Expression,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -488,9 +531,12 @@ pub struct PunchSpec {
     /// plane: the normal pointing out of the punch, towards the plate.
     #[serde(default)]
     pub normal: Option<Direction>,
-    /// Punch displacement at load factor 1 ...
+    /// expression: Psi in x1, x2, x3 (negative inside the punch, zero on its surface).
     #[serde(default)]
-    pub motion: Option<Vec3>,
+    pub psi: Option<Spanned<String>>,
+    /// Punch displacement at load factor 1, or a path of rows [t, d1, d2, d3] ...
+    #[serde(default)]
+    pub motion: Option<MotionSpec>,
     /// ... or the force pressing the punch at load factor 1 (its displacement along `direction` is
     /// then an unknown).
     #[serde(default)]
@@ -762,6 +808,22 @@ impl Problem {
         StampError::Input { file: self.path.display().to_string(), message: format!("line {line}, column {col}: {key}: {message}") }
     }
 
+    /// An error in the expression `psi` at its 1-based character `column`: located in the file
+    /// when the string is written without escapes (the column inside the string maps to the file),
+    /// else at the string's start, naming the column inside it.
+    pub fn psi_error(&self, psi: &Spanned<String>, column: usize, key: &str, message: &str) -> StampError {
+        let span = psi.span();
+        let raw = self.source.get(span.clone()).unwrap_or("");
+        let text = psi.get_ref();
+        let inner = raw.strip_prefix('"').and_then(|r| r.strip_suffix('"')).or_else(|| raw.strip_prefix('\'').and_then(|r| r.strip_suffix('\'')));
+        if inner == Some(text.as_str()) && !text.contains('\n') {
+            let offset: usize = text.chars().take(column - 1).map(char::len_utf8).sum();
+            self.error_at(span.start + 1 + offset..span.end, key, message)
+        } else {
+            self.error_at(span, key, format!("column {column} of the expression: {message}"))
+        }
+    }
+
     /// Checks between keys that serde cannot express.
     fn check(&self) -> Result<()> {
         let s = &self.spec;
@@ -859,6 +921,19 @@ impl Problem {
                     ps.point.is_some() && ps.normal.is_some() && ps.radius.is_none() && ps.axis.is_none() && ps.center.is_none(),
                     "a plane needs `point` and `normal` (and no `radius`, `axis` or `center`)",
                 )?,
+                Shape::Expression => {
+                    need(
+                        ps.psi.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
+                        "an expression punch needs `psi` (and no `point`, `axis`, `center`, `radius` or `normal`)",
+                    )?;
+                    let psi = ps.psi.as_ref().unwrap();
+                    if let Err(e) = stamp_contact::expression_parser::parse(psi.get_ref()) {
+                        return Err(self.psi_error(psi, e.column, &format!("{key}.psi"), &e.message));
+                    }
+                }
+            }
+            if ps.shape != Shape::Expression && ps.psi.is_some() {
+                return Err(self.error_at(ps.psi.as_ref().unwrap().span(), &format!("{key}.psi"), "`psi` belongs to shape = \"expression\""));
             }
             if ps.force.is_some() && ps.motion.is_some() {
                 return Err(self.error_at(p.span(), &format!("{key}.force"), "give `motion` (displacement driven) or `force` (force driven), not both"));

@@ -32,7 +32,11 @@ struct PunchMeta {
     name: String,
     surface: String,
     face: String,
+    /// The prescribed displacement at load factor 1.
     motion: [f64; 3],
+    /// A motion along a path: its points [t, d1, d2, d3] (starting at [0, 0, 0, 0]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    motion_path: Option<Vec<[f64; 4]>>,
     /// Force-driven punches: the force at load factor 1 and its direction.
     force: Option<f64>,
     direction: Option<[f64; 3]>,
@@ -169,6 +173,18 @@ fn json_err(e: serde_json::Error) -> StampError {
 }
 
 /// The default output folder: `<problem dir>/<problem stem>-out`.
+/// The first punch whose surface reports a non-finite evaluation, as an error at its `psi` key.
+fn surface_failure(p: &Problem, contacts: &[stamp::contact::ContactPair]) -> Option<StampError> {
+    contacts.iter().enumerate().find_map(|(i, c)| {
+        let m = c.surface.evaluation_error()?;
+        let key = format!("punch[{i}].psi");
+        Some(match p.spec.punch.get(i).and_then(|s| s.get_ref().psi.as_ref()) {
+            Some(psi) => p.error_at(psi.span(), &key, m),
+            None => StampError::Input { file: p.path.display().to_string(), message: format!("punch[{i}]: {m}") },
+        })
+    })
+}
+
 pub fn default_out_dir(problem: &Path) -> PathBuf {
     let stem = problem.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "problem".into());
     let dir = problem.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
@@ -216,7 +232,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     }
     let units = Units::new(p.spec.units.as_ref());
     let punch_names: Vec<String> = punches.iter().map(|i| i.name.clone()).collect();
-    let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.is_some() || c.motion == [0.0; 3])).collect();
+    let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.is_some() || c.motion.is_zero())).collect();
     let mut history = History::new(&punch_keys, &point_groups);
     let mut probes = Probes::new(p, &mesh, &out.probe, &punch_names)?;
 
@@ -241,7 +257,11 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
                 name: i.name.clone(),
                 surface: i.surface.describe(),
                 face: format!("{:?}", i.face).to_lowercase(),
-                motion: c.motion,
+                motion: c.motion.displacement(1.0),
+                motion_path: match &c.motion {
+                    stamp::contact::PunchMotion::Path(points) => Some(points.iter().map(|(t, d)| [*t, d[0], d[1], d[2]]).collect()),
+                    stamp::contact::PunchMotion::Linear(_) => None,
+                },
                 force: c.drive.map(|f| f.force),
                 direction: c.drive.map(|f| f.direction),
                 eps_reg: i.eps_reg,
@@ -276,8 +296,18 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     newton.stop = Some(stop.clone());
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
+    let mut surface_error: Option<StampError> = None;
     let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
         total_iterations += rep.iterations;
+        // a punch whose Psi was not finite somewhere (an expression's sqrt of a negative number)
+        // stops the run: its answer would be wrong
+        if surface_error.is_none() {
+            surface_error = surface_failure(p, &m.contacts);
+            if surface_error.is_some() {
+                stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                return;
+            }
+        }
         let t = rep.load_factor;
         path_len += (t - t_last).abs();
         t_last = t;
@@ -367,7 +397,8 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     drop(cx);
     summary.newton_iterations = total_iterations;
     // after a write failure the solve stopped on request: that is no failure of its own
-    let solve_failure = if write_error.is_some() { None } else { result.err() };
+    let surface_error = surface_error.or_else(|| surface_failure(p, &model.contacts));
+    let solve_failure = if write_error.is_some() { None } else { surface_error.or(result.err()) };
     if let Some(e) = &solve_failure {
         let lf = match e {
             StampError::NoConvergence { load_factor, .. } => Some(*load_factor),
