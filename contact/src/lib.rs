@@ -1,7 +1,8 @@
 //! # stamp-contact — rigid punch shapes
 //!
 //! Implementations of [`stamp::surface::ContactSurface`] for the punches of the paper: a
-//! [`Cylinder`] (eq. 3.6), a [`Sphere`] and a [`Plane`]. Each surface is an implicit function
+//! [`Cylinder`] (eq. 3.6), a [`Sphere`] and a [`Plane`], and a die of any shape given as a
+//! triangulated surface ([`StlSurface`], read from an STL file). Each surface is an implicit function
 //! Psi(x) that is negative inside the punch, zero on its surface and positive outside, with its
 //! analytic gradient and Hessian.
 //!
@@ -12,10 +13,12 @@
 mod cylinder;
 mod plane;
 mod sphere;
+pub mod stl;
 
 pub use cylinder::Cylinder;
 pub use plane::Plane;
 pub use sphere::Sphere;
+pub use stl::StlSurface;
 
 use nalgebra::Vector3;
 use stamp::{Result, StampError};

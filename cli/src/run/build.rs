@@ -34,7 +34,7 @@ use stamp::model::Model;
 use stamp::nonlinear::NewtonSettings;
 use stamp::surface::ContactSurface;
 use stamp::{Result, StampError};
-use stamp_contact::{Cylinder, Plane, Sphere};
+use stamp_contact::{Cylinder, Plane, Sphere, StlSurface};
 use stamp_elements::{Face, Isotropic, Kinematics, PlateElements, Section};
 use std::sync::Arc;
 
@@ -234,6 +234,7 @@ pub fn build(p: &Problem) -> Result<Setup> {
             Shape::Cylinder => Arc::new(Cylinder::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.axis.unwrap().0), spec.radius.unwrap().0).map_err(wrap)?),
             Shape::Sphere => Arc::new(Sphere::new(Vector3::from(spec.center.unwrap().0), spec.radius.unwrap().0).map_err(wrap)?),
             Shape::Plane => Arc::new(Plane::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.normal.unwrap().0)).map_err(wrap)?),
+            Shape::Stl => Arc::new(stl_die(p, spec.file.as_ref().expect("checked: stl has file"), &key)?),
         };
         let face = face_of(spec.face);
         let z = match face {
@@ -332,6 +333,13 @@ pub fn build(p: &Problem) -> Result<Setup> {
     }
     settings.validate().map_err(|e| StampError::Input { file: p.path.display().to_string(), message: format!("[solver]: {e}") })?;
     Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings })
+}
+
+/// The STL die of a punch: `file` relative to the problem file; errors name the problem file, the
+/// key and the STL file.
+fn stl_die(p: &Problem, file: &toml::Spanned<String>, key: &str) -> Result<StlSurface> {
+    let path = p.dir().join(file.get_ref());
+    StlSurface::from_file(&path).map_err(|e| p.error_at(file.span(), &format!("{key}.file"), e))
 }
 
 /// The size of the model as a length: the largest of the coordinates' magnitudes, the face

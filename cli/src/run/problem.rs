@@ -442,6 +442,8 @@ pub enum Shape {
     Cylinder,
     Sphere,
     Plane,
+    /// A triangulated surface read from an STL file (`file`).
+    Stl,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -480,6 +482,10 @@ pub struct PunchSpec {
     /// plane: the normal pointing out of the punch, towards the plate.
     #[serde(default)]
     pub normal: Option<Direction>,
+    /// stl: the STL file (ASCII or binary), relative to the problem file; its facet normals point
+    /// to the plate's side.
+    #[serde(default)]
+    pub file: Option<Spanned<String>>,
     /// Punch displacement at load factor 1 ...
     #[serde(default)]
     pub motion: Option<Vec3>,
@@ -830,6 +836,13 @@ impl Problem {
                     ps.point.is_some() && ps.normal.is_some() && ps.radius.is_none() && ps.axis.is_none() && ps.center.is_none(),
                     "a plane needs `point` and `normal` (and no `radius`, `axis` or `center`)",
                 )?,
+                Shape::Stl => need(
+                    ps.file.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
+                    "an stl die needs `file` (and no `point`, `axis`, `center`, `radius` or `normal`: the die is where the file puts it)",
+                )?,
+            }
+            if ps.file.is_some() && ps.shape != Shape::Stl {
+                return Err(self.error_at(p.span(), &format!("{key}.file"), "`file` is the STL file of shape = \"stl\""));
             }
             if ps.force.is_some() && ps.motion.is_some() {
                 return Err(self.error_at(p.span(), &format!("{key}.force"), "give `motion` (displacement driven) or `force` (force driven), not both"));
