@@ -9,6 +9,14 @@ use std::path::Path;
 /// onto the sphere of radius `r` about `c`; facets counter-clockwise seen from outside (outward
 /// normals). 20 * 4^levels facets.
 pub fn icosphere(levels: u32, r: f64, c: [f64; 3]) -> Vec<[[f64; 3]; 3]> {
+    icosphere_cap(levels, r, c, std::f64::consts::PI)
+}
+
+/// The facets of [`icosphere`] within `angle` (radians) of its lowest point (0, 0, -r) from the
+/// centre: facets farther than that are dropped at every level, so that a fine cap costs only its
+/// own facets. The icosahedron is symmetric about x1 = 0 and x2 = 0, and (0, 0, -r) is a vertex
+/// from one subdivision on.
+pub fn icosphere_cap(levels: u32, r: f64, c: [f64; 3], angle: f64) -> Vec<[[f64; 3]; 3]> {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
     let mut v: Vec<[f64; 3]> = vec![
         [-1.0, t, 0.0], [1.0, t, 0.0], [-1.0, -t, 0.0], [1.0, -t, 0.0],
@@ -45,6 +53,11 @@ pub fn icosphere(levels: u32, r: f64, c: [f64; 3]) -> Vec<[[f64; 3]; 3]> {
             nf.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
         }
         f = nf;
+        // keep the facets with a corner within the cap (a facet's angular size shrinks by 2 a level)
+        let keep = |p: &[f64; 3]| -p[2] >= (angle.min(std::f64::consts::PI)).cos();
+        if angle < std::f64::consts::PI {
+            f.retain(|t| t.iter().any(|&i| keep(&v[i])));
+        }
     }
     f.iter()
         .map(|t| t.map(|i| [c[0] + r * v[i][0], c[1] + r * v[i][1], c[2] + r * v[i][2]]))
