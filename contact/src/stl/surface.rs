@@ -108,8 +108,16 @@ fn closest_on_triangle(x: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>, c: 
     Closest { point: a + ab * v + ac * w, bary: [1.0 - v - w, v, w], region: Region::Inside }
 }
 
+thread_local! {
+    /// This thread's last query: (surface id, x's bits) and what it found.
+    static LAST_QUERY: std::cell::Cell<Option<((u64, [u64; 3]), Query)>> = const { std::cell::Cell::new(None) };
+}
+
 /// A rigid die bounded by a triangulated surface read from an STL file.
 pub struct StlSurface {
+    /// Unique among all surfaces made in this process: the key of the per-thread query cache
+    /// (an address could be reused by a surface made after this one is dropped).
+    id: u64,
     name: String,
     vertices: Vec<Vector3<f64>>,
     facets: Vec<[u32; 3]>,
@@ -121,6 +129,7 @@ pub struct StlSurface {
 }
 
 /// What a query finds: the closest point, its facet, and the interpolated normal.
+#[derive(Clone, Copy)]
 struct Query {
     closest: Closest,
     facet: usize,
@@ -181,7 +190,9 @@ impl StlSurface {
             hi = hi.sup(v);
         }
         let length_scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
-        Ok(Self { name: name.to_string(), vertices, facets: mesh.facets, vertex_normals: normals, tree, length_scale, lo, hi })
+        static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Ok(Self { id, name: name.to_string(), vertices, facets: mesh.facets, vertex_normals: normals, tree, length_scale, lo, hi })
     }
 
     /// Number of facets.
@@ -194,7 +205,21 @@ impl StlSurface {
         self.vertices.len()
     }
 
+    /// The query at x, reusing this thread's last one when it was at the same x on this surface:
+    /// the contact constraint asks for the gradient and Psi (and the Hessian) at one point in turn.
     fn query(&self, x: &Vector3<f64>) -> Query {
+        let key = (self.id, [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]);
+        if let Some((k, q)) = LAST_QUERY.with(|c| c.get()) {
+            if k == key {
+                return q;
+            }
+        }
+        let q = self.search(x);
+        LAST_QUERY.with(|c| c.set(Some((key, q))));
+        q
+    }
+
+    fn search(&self, x: &Vector3<f64>) -> Query {
         let f = self.tree.nearest_neighbor(&[x.x, x.y, x.z]).expect("the tree has facets");
         let t = self.facets[f.index as usize];
         let [a, b, c] = t.map(|i| self.vertices[i as usize]);
