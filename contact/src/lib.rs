@@ -1,8 +1,9 @@
 //! # stamp-contact — rigid punch shapes
 //!
 //! Implementations of [`stamp::surface::ContactSurface`] for the punches of the paper: a
-//! [`Cylinder`] (eq. 3.6), a [`Sphere`], a [`Plane`], and an [`Expression`]: Psi written by the
-//! user in x1, x2, x3, differentiated exactly by forward-mode automatic differentiation. Each surface is an implicit function
+//! [`Cylinder`] (eq. 3.6), a [`Sphere`], a [`Plane`], an [`Expression`] (Psi written by the user
+//! in x1, x2, x3, differentiated exactly by forward-mode automatic differentiation) and a die of any
+//! shape given as a triangulated surface ([`StlSurface`], read from an STL file). Each surface is an implicit function
 //! Psi(x) that is negative inside the punch, zero on its surface and positive outside, with its
 //! analytic gradient and Hessian.
 //!
@@ -16,11 +17,13 @@ pub mod expression_parser;
 pub mod jet;
 mod plane;
 mod sphere;
+pub mod stl;
 
 pub use cylinder::Cylinder;
 pub use expression::Expression;
 pub use plane::Plane;
 pub use sphere::Sphere;
+pub use stl::StlSurface;
 
 use nalgebra::Vector3;
 use stamp::{Result, StampError};

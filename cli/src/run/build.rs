@@ -39,7 +39,7 @@ use stamp::model::Model;
 use stamp::nonlinear::NewtonSettings;
 use stamp::surface::ContactSurface;
 use stamp::{Result, StampError};
-use stamp_contact::{Cylinder, Expression, Plane, Sphere};
+use stamp_contact::{Cylinder, Expression, Plane, Sphere, StlSurface};
 use stamp_elements::{fixed_couple_force, Face, FollowerCouple, FollowerPressure, Isotropic, Kinematics, PlateElements, Section};
 use std::sync::Arc;
 
@@ -277,6 +277,7 @@ pub fn build(p: &Problem) -> Result<Setup> {
                 let psi = spec.psi.as_ref().unwrap();
                 Arc::new(Expression::new(psi.get_ref(), model_size(&mesh, &section, None)).map_err(|e| p.psi_error(psi, e.column, &format!("{key}.psi"), &e.message))?)
             }
+            Shape::Stl => Arc::new(stl_die(p, spec.file.as_ref().expect("checked: stl has file"), &key)?),
         };
         let face = face_of(spec.face);
         let z = match face {
@@ -385,6 +386,13 @@ pub fn build(p: &Problem) -> Result<Setup> {
     }
     settings.validate().map_err(|e| StampError::Input { file: p.path.display().to_string(), message: format!("[solver]: {e}") })?;
     Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings })
+}
+
+/// The STL die of a punch: `file` relative to the problem file; errors name the problem file, the
+/// key and the STL file.
+fn stl_die(p: &Problem, file: &toml::Spanned<String>, key: &str) -> Result<StlSurface> {
+    let path = p.dir().join(file.get_ref());
+    StlSurface::from_file(&path).map_err(|e| p.error_at(file.span(), &format!("{key}.file"), e))
 }
 
 /// The size of the model as a length: the largest of the coordinates' magnitudes, the face

@@ -493,6 +493,8 @@ pub enum Shape {
     Plane,
     /// Psi written as an expression in x1, x2, x3 (`psi`).
     Expression,
+    /// A triangulated surface read from an STL file (`file`).
+    Stl,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -531,6 +533,10 @@ pub struct PunchSpec {
     /// plane: the normal pointing out of the punch, towards the plate.
     #[serde(default)]
     pub normal: Option<Direction>,
+    /// stl: the STL file (ASCII or binary), relative to the problem file; its facet normals point
+    /// to the plate's side.
+    #[serde(default)]
+    pub file: Option<Spanned<String>>,
     /// expression: Psi in x1, x2, x3 (negative inside the punch, zero on its surface).
     #[serde(default)]
     pub psi: Option<Spanned<String>>,
@@ -931,9 +937,16 @@ impl Problem {
                         return Err(self.psi_error(psi, e.column, &format!("{key}.psi"), &e.message));
                     }
                 }
+                Shape::Stl => need(
+                    ps.file.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
+                    "an stl die needs `file` (and no `point`, `axis`, `center`, `radius` or `normal`: the die is where the file puts it)",
+                )?,
             }
             if ps.shape != Shape::Expression && ps.psi.is_some() {
                 return Err(self.error_at(ps.psi.as_ref().unwrap().span(), &format!("{key}.psi"), "`psi` belongs to shape = \"expression\""));
+            }
+            if ps.file.is_some() && ps.shape != Shape::Stl {
+                return Err(self.error_at(ps.file.as_ref().unwrap().span(), &format!("{key}.file"), "`file` is the STL file of shape = \"stl\""));
             }
             if ps.force.is_some() && ps.motion.is_some() {
                 return Err(self.error_at(p.span(), &format!("{key}.force"), "give `motion` (displacement driven) or `force` (force driven), not both"));
