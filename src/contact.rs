@@ -28,6 +28,7 @@
 
 use crate::surface::ContactSurface;
 use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// How the constraint is evaluated.
@@ -233,6 +234,10 @@ pub struct ContactPair {
     /// The largest |lambda| seen in the current load step (the scale of "near the kink" for
     /// frozen points while every point is momentarily inactive).
     pub lambda_scale: f64,
+    /// Psi and its gradient at every point for the current evaluation (exact kinematics),
+    /// computed in parallel before the points are visited in order: a die given by a triangle
+    /// mesh or an expression costs microseconds per point.
+    surface_at_points: Vec<(f64, Vector3<f64>)>,
 }
 
 impl ContactPair {
@@ -255,6 +260,7 @@ impl ContactPair {
             initialized: false,
             max_flips: 10,
             lambda_scale: 0.0,
+            surface_at_points: vec![(0.0, Vector3::zeros()); n],
         }
     }
 
@@ -318,6 +324,16 @@ impl ContactPair {
         self.lambda_scale = self.lambda_scale.max(current);
         let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
         let mut any_tangent = false;
+        if let ContactKinematics::Exact = self.kinematics {
+            let surface = &*self.surface;
+            self.surface_at_points.par_iter_mut().zip(self.points.par_iter()).with_min_len(512).for_each(|(out, p)| {
+                // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
+                crate::linalg::vector_state::clean_upper_vector_state();
+                let x = Vector3::from(p.x_ref) + Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]) - d;
+                let g = surface.gradient(&x);
+                *out = (surface.psi(&x), g);
+            });
+        }
         for (k, p) in self.points.iter().enumerate() {
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
@@ -325,8 +341,8 @@ impl ContactPair {
             let (psi, grad, grad_s, hess) = match self.kinematics {
                 ContactKinematics::Exact => {
                     let x = x_ref + disp - d;
-                    let g = self.surface.gradient(&x);
-                    (self.surface.psi(&x), g, -g.dot(&dn), Some(x))
+                    let (psi, g) = self.surface_at_points[k];
+                    (psi, g, -g.dot(&dn), Some(x))
                 }
                 ContactKinematics::Shallow { direction } => {
                     // linearised about the reference position and the prescribed motion: in the

@@ -28,15 +28,23 @@ use std::path::Path;
 struct Facet {
     index: u32,
     corners: [[f64; 3]; 3],
+    /// The corners' bounding box, kept: the search asks for it at every facet it meets.
+    bounds: AABB<[f64; 3]>,
+}
+
+impl Facet {
+    fn new(index: u32, corners: [[f64; 3]; 3]) -> Self {
+        let [a, b, c] = corners;
+        let lo = [0, 1, 2].map(|i| a[i].min(b[i]).min(c[i]));
+        let hi = [0, 1, 2].map(|i| a[i].max(b[i]).max(c[i]));
+        Facet { index, corners, bounds: AABB::from_corners(lo, hi) }
+    }
 }
 
 impl RTreeObject for Facet {
     type Envelope = AABB<[f64; 3]>;
     fn envelope(&self) -> Self::Envelope {
-        let [a, b, c] = self.corners;
-        let lo = [0, 1, 2].map(|i| a[i].min(b[i]).min(c[i]));
-        let hi = [0, 1, 2].map(|i| a[i].max(b[i]).max(c[i]));
-        AABB::from_corners(lo, hi)
+        self.bounds
     }
 }
 
@@ -45,6 +53,16 @@ impl PointDistance for Facet {
         let [a, b, c] = self.corners.map(Vector3::from);
         let q = closest_on_triangle(&Vector3::from(*point), &a, &b, &c);
         (q.point - Vector3::from(*point)).norm_squared()
+    }
+
+    /// The facet's box first (a few comparisons): most facets the search meets are farther than
+    /// the best so far, and the exact distance is only computed for the others.
+    fn distance_2_if_less_or_equal(&self, point: &[f64; 3], max_distance_2: f64) -> Option<f64> {
+        if self.bounds.distance_2(point) > max_distance_2 {
+            return None;
+        }
+        let d = self.distance_2(point);
+        (d <= max_distance_2).then_some(d)
     }
 }
 
@@ -118,6 +136,10 @@ pub struct StlSurface {
     /// Unique among all surfaces made in this process: the key of the per-thread query cache
     /// (an address could be reused by a surface made after this one is dropped).
     id: u64,
+    /// Squared distance up to which a hint bounds a search (beyond it the box about the point
+    /// would hold too many facets and the tree's nearest-neighbour search is cheaper): four times
+    /// the longest facet edge.
+    hint_reach_2: f64,
     name: String,
     vertices: Vec<Vector3<f64>>,
     facets: Vec<[u32; 3]>,
@@ -180,7 +202,7 @@ impl StlSurface {
             .facets
             .iter()
             .enumerate()
-            .map(|(k, t)| Facet { index: k as u32, corners: t.map(|i| mesh.vertices[i as usize]) })
+            .map(|(k, t)| Facet::new(k as u32, t.map(|i| mesh.vertices[i as usize])))
             .collect();
         let tree = RTree::bulk_load(items);
         let mut lo = Vector3::repeat(f64::INFINITY);
@@ -192,7 +214,16 @@ impl StlSurface {
         let length_scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
         static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let id = NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        Ok(Self { id, name: name.to_string(), vertices, facets: mesh.facets, vertex_normals: normals, tree, length_scale, lo, hi })
+        let longest_edge_2 = mesh
+            .facets
+            .iter()
+            .flat_map(|t| {
+                let v = &vertices;
+                (0..3).map(move |k| (v[t[k] as usize] - v[t[(k + 1) % 3] as usize]).norm_squared())
+            })
+            .fold(0.0, f64::max);
+        let hint_reach_2 = 16.0 * longest_edge_2;
+        Ok(Self { id, hint_reach_2, name: name.to_string(), vertices, facets: mesh.facets, vertex_normals: normals, tree, length_scale, lo, hi })
     }
 
     /// Number of facets.
@@ -209,23 +240,56 @@ impl StlSurface {
     /// the contact constraint asks for the gradient and Psi (and the Hessian) at one point in turn.
     fn query(&self, x: &Vector3<f64>) -> Query {
         let key = (self.id, [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]);
-        if let Some((k, q)) = LAST_QUERY.with(|c| c.get()) {
+        let last = LAST_QUERY.with(|c| c.get());
+        if let Some((k, q)) = last {
             if k == key {
                 return q;
             }
         }
-        let q = self.search(x);
+        let hint = last.filter(|((id, _), _)| *id == self.id).map(|(_, q)| q.facet);
+        let q = self.search(x, hint);
         LAST_QUERY.with(|c| c.set(Some((key, q))));
         q
     }
 
-    fn search(&self, x: &Vector3<f64>) -> Query {
-        let f = self.tree.nearest_neighbor(&[x.x, x.y, x.z]).expect("the tree has facets");
-        let t = self.facets[f.index as usize];
-        let [a, b, c] = t.map(|i| self.vertices[i as usize]);
-        let closest = closest_on_triangle(x, &a, &b, &c);
-        let m = (0..3).fold(Vector3::zeros(), |s, k| s + closest.bary[k] * self.vertex_normals[t[k] as usize]);
-        Query { closest, facet: f.index as usize, m }
+    /// The closest point of the surface to x. `hint`, a facet close to x (the last query's: the
+    /// contact points are visited in the mesh's order, neighbours after neighbours), bounds the
+    /// search: every facet closer than it meets the box of half-width |x - hint| about x.
+    fn search(&self, x: &Vector3<f64>, hint: Option<usize>) -> Query {
+        let p = [x.x, x.y, x.z];
+        let facet = |k: usize| {
+            let t = self.facets[k];
+            let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+            closest_on_triangle(x, &a, &b, &c)
+        };
+        let mut best = None;
+        if let Some(h) = hint {
+            let c = facet(h);
+            let d2 = (c.point - x).norm_squared();
+            if d2 <= self.hint_reach_2 {
+                let r = d2.sqrt() * (1.0 + 1e-9) + 1e-12 * self.length_scale;
+                let envelope = AABB::from_corners([x.x - r, x.y - r, x.z - r], [x.x + r, x.y + r, x.z + r]);
+                let mut found = (h, c, d2);
+                for f in self.tree.locate_in_envelope_intersecting(&envelope) {
+                    let k = f.index as usize;
+                    if k != found.0 && f.bounds.distance_2(&p) < found.2 {
+                        let c = facet(k);
+                        let d2 = (c.point - x).norm_squared();
+                        if d2 < found.2 {
+                            found = (k, c, d2);
+                        }
+                    }
+                }
+                best = Some((found.0, found.1));
+            }
+        }
+        let (k, closest) = best.unwrap_or_else(|| {
+            let k = self.tree.nearest_neighbor(&p).expect("the tree has facets").index as usize;
+            (k, facet(k))
+        });
+        let t = self.facets[k];
+        let m = (0..3).fold(Vector3::zeros(), |s, i| s + closest.bary[i] * self.vertex_normals[t[i] as usize]);
+        Query { closest, facet: k, m }
     }
 
     /// The normal at the query's point (the facet's normal if the vertex normals cancel).
@@ -300,5 +364,59 @@ impl ContactSurface for StlSurface {
             self.hi.y,
             self.hi.z
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wavy height field z = 0.3 sin(x) cos(y) over [-5, 5]^2, 40 x 40 squares cut in two.
+    fn wavy() -> StlSurface {
+        let n = 40;
+        let z = |x: f64, y: f64| 0.3 * x.sin() * y.cos();
+        let mut vertices = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let (x, y) = (-5.0 + 10.0 * i as f64 / n as f64, -5.0 + 10.0 * j as f64 / n as f64);
+                vertices.push([x, y, z(x, y)]);
+            }
+        }
+        let id = |i: u32, j: u32| j * (n + 1) + i;
+        let mut facets = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                facets.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                facets.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        StlSurface::from_mesh("wavy", TriangleMesh { vertices, facets }).unwrap()
+    }
+
+    #[test]
+    fn a_hinted_search_finds_the_closest_facet() {
+        let s = wavy();
+        let brute = |x: &Vector3<f64>| {
+            (0..s.facets.len())
+                .map(|k| {
+                    let [a, b, c] = s.facets[k].map(|i| s.vertices[i as usize]);
+                    (closest_on_triangle(x, &a, &b, &c).point - x).norm_squared()
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        // a scrambled sequence of points up to 2 from the surface, some beyond its edges, with
+        // hints from the last point (near or far from the new one) and from a fixed far facet
+        let mut last = None;
+        for k in 0..2000 {
+            let f = |a: f64| (k as f64 * a).fract();
+            let x = Vector3::new(-6.0 + 12.0 * f(0.6180339887), -6.0 + 12.0 * f(0.4142135623), -2.0 + 4.0 * f(0.7320508075));
+            let want = brute(&x);
+            for hint in [None, last, Some(0), Some(s.facets.len() - 1)] {
+                let q = s.search(&x, hint);
+                let got = (q.closest.point - x).norm_squared();
+                assert!((got - want).abs() <= 1e-12 * want.max(1.0), "point {x:?}, hint {hint:?}: {got} against {want}");
+            }
+            last = Some(s.search(&x, last).facet);
+        }
     }
 }
