@@ -471,3 +471,61 @@ fn cantilever_under_follower_pressure_bends_further_than_under_dead_pressure() {
     }
     assert!(reports.iter().all(|r| r.iterations <= 8), "Newton needed more than 8 iterations in a step: {:?}", reports.iter().map(|r| r.iterations).collect::<Vec<_>>());
 }
+
+/// The tip deflection (downwards) and the tip's displacement along the strip (towards the root
+/// positive) of an inextensible, unshearable cantilever of length `l` and bending stiffness `d`
+/// under a follower pressure `p` on its top face (the planar Kirchhoff rod, e.g. S. S. Antman,
+/// Nonlinear Problems of Elasticity, 2nd ed., ch. 4): with t = (cos phi, sin phi) the tangent,
+/// n = (-sin phi, cos phi) the upward normal, F = N t + V n the force of the outer part on the
+/// inner one and M = d phi' the bending moment, equilibrium under the load -q n per unit length is
+/// N' = V phi', V' = q - N phi', M' = -V: free of phi, so it is integrated from the free end
+/// (N = V = M = 0) to the root, then phi, x2 and x3 from the clamped root (phi = 0). The top face
+/// of thickness `h` is 1 - (h/2) phi' times as long as the axis, q = p (1 - (h/2) phi'). RK4.
+fn follower_elastica_tip(l: f64, h: f64, d: f64, p: f64) -> (f64, f64) {
+    let steps = 20_000;
+    let ds = l / steps as f64;
+    // from the tip back to the root: y = (N, V, M), curvature kappa = M / d
+    let rhs = |y: [f64; 3]| {
+        let kappa = y[2] / d;
+        let q = p * (1.0 - 0.5 * h * kappa);
+        [y[1] * kappa, q - y[0] * kappa, -y[1]]
+    };
+    let mut y = [0.0; 3];
+    let mut kappa = vec![0.0; steps + 1];
+    for k in (0..steps).rev() {
+        // d/ds with s decreasing: y(s - ds) = y(s) - ds y'
+        let add = |y: [f64; 3], f: [f64; 3], c: f64| [y[0] + c * f[0], y[1] + c * f[1], y[2] + c * f[2]];
+        let k1 = rhs(y);
+        let k2 = rhs(add(y, k1, -0.5 * ds));
+        let k3 = rhs(add(y, k2, -0.5 * ds));
+        let k4 = rhs(add(y, k3, -ds));
+        for i in 0..3 {
+            y[i] -= ds / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+        kappa[k] = y[2] / d;
+    }
+    // phi (trapezoidal in kappa), then x2 and x3 (Simpson) from the root
+    let (mut phi, mut x2, mut x3) = (0.0f64, 0.0, 0.0);
+    for k in 0..steps {
+        let phi_mid = phi + 0.125 * ds * (3.0 * kappa[k] + kappa[k + 1]);
+        let phi_end = phi + 0.5 * ds * (kappa[k] + kappa[k + 1]);
+        x2 += ds / 6.0 * (phi.cos() + 4.0 * phi_mid.cos() + phi_end.cos());
+        x3 += ds / 6.0 * (phi.sin() + 4.0 * phi_mid.sin() + phi_end.sin());
+        phi = phi_end;
+    }
+    (-x3, l - x2)
+}
+
+#[test]
+fn cantilever_under_follower_pressure_follows_the_elastica() {
+    // plane strain: D = E h^3 / (12 (1 - nu^2)); q L^3 / D = 3, as above
+    let (l, h) = (10.0, 0.1);
+    let d = 1.0e4 * h * h * h / (12.0 * (1.0 - 0.09));
+    let p = 3.0 * d / (l * l * l);
+    let (w_ref, shortening_ref) = follower_elastica_tip(l, h, d, p);
+    let (w, _, _, _) = clamped_strip(true, p, false);
+    println!("cantilever under a follower pressure, q L^3 / D = 3: tip deflection {w:.5} (plate, 40 cells), {w_ref:.5} (elastica; tip moves {shortening_ref:.5} towards the root)");
+    assert!(w_ref > 2.0, "the reference hardly deflects: {w_ref}");
+    // measured: 3e-6 apart (the plate's stretching and shear are of order (h / L)^2)
+    assert!((w - w_ref).abs() <= 1e-3 * w_ref, "tip deflection {w} against the elastica's {w_ref}");
+}
