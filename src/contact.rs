@@ -197,6 +197,14 @@ pub struct PointState {
     pub active: bool,
 }
 
+/// Psi and its gradient at a point's last position (see `ContactPair::surface_at_points`).
+#[derive(Debug, Clone, Copy)]
+struct SurfaceAtPoint {
+    x: Vector3<f64>,
+    psi: f64,
+    grad: Vector3<f64>,
+}
+
 /// A rigid punch, its motion, and the points of the body that may touch it.
 pub struct ContactPair {
     pub name: String,
@@ -234,10 +242,12 @@ pub struct ContactPair {
     /// The largest |lambda| seen in the current load step (the scale of "near the kink" for
     /// frozen points while every point is momentarily inactive).
     pub lambda_scale: f64,
-    /// Psi and its gradient at every point for the current evaluation (exact kinematics),
-    /// computed in parallel before the points are visited in order: a die given by a triangle
-    /// mesh or an expression costs microseconds per point.
-    surface_at_points: Vec<(f64, Vector3<f64>)>,
+    /// Where each point was at the last evaluation (exact kinematics), and Psi and its gradient
+    /// there: computed in parallel before the points are visited in order (a die given by a
+    /// triangle mesh or an expression costs microseconds per point), and not again while the
+    /// point stays where it was (Newton's next iteration starts where the line search's accepted
+    /// trial evaluated).
+    surface_at_points: Vec<SurfaceAtPoint>,
 }
 
 impl ContactPair {
@@ -260,7 +270,7 @@ impl ContactPair {
             initialized: false,
             max_flips: 10,
             lambda_scale: 0.0,
-            surface_at_points: vec![(0.0, Vector3::zeros()); n],
+            surface_at_points: vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; n],
         }
     }
 
@@ -330,8 +340,11 @@ impl ContactPair {
                 // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
                 crate::linalg::vector_state::clean_upper_vector_state();
                 let x = Vector3::from(p.x_ref) + Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]) - d;
-                let g = surface.gradient(&x);
-                *out = (surface.psi(&x), g);
+                // (NaN at the start: never equal)
+                if x != out.x {
+                    let grad = surface.gradient(&x);
+                    *out = SurfaceAtPoint { x, psi: surface.psi(&x), grad };
+                }
             });
         }
         for (k, p) in self.points.iter().enumerate() {
@@ -341,7 +354,7 @@ impl ContactPair {
             let (psi, grad, grad_s, hess) = match self.kinematics {
                 ContactKinematics::Exact => {
                     let x = x_ref + disp - d;
-                    let (psi, g) = self.surface_at_points[k];
+                    let SurfaceAtPoint { psi, grad: g, .. } = self.surface_at_points[k];
                     (psi, g, -g.dot(&dn), Some(x))
                 }
                 ContactKinematics::Shallow { direction } => {
