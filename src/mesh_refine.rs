@@ -132,6 +132,23 @@ pub fn refine(mesh: &QuadMesh) -> Refinement {
     r
 }
 
+/// The (nodes, cells) of `mesh` refined 1, 2, ..., `levels` times, counted without refining:
+/// a refinement adds a node per edge and per cell, cuts every edge in two and adds four edges per
+/// cell (u64: no overflow for any level a caller could ask).
+pub fn refined_sizes(mesh: &QuadMesh, levels: usize) -> Vec<(u64, u64)> {
+    let edges: std::collections::HashSet<(usize, usize)> =
+        mesh.cells.iter().flat_map(|c| (0..4).map(move |i| key(c[i], c[(i + 1) % 4]))).collect();
+    let (mut n, mut e, mut c) = (mesh.num_nodes() as u64, edges.len() as u64, mesh.num_cells() as u64);
+    let mut out = Vec::with_capacity(levels);
+    for _ in 0..levels {
+        n = n.saturating_add(e).saturating_add(c);
+        e = e.saturating_mul(2).saturating_add(c.saturating_mul(4));
+        c = c.saturating_mul(4);
+        out.push((n, c));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -165,6 +182,9 @@ mod tests {
         r.mesh.validate().expect("every refined cell counter-clockwise and convex");
         let rr = refine(&r.mesh);
         assert_eq!((rr.mesh.num_nodes(), rr.mesh.num_cells()), (13 * 9, 96), "twice: the 12 x 8 grid");
+        let counted = refined_sizes(&m, 3);
+        assert_eq!(counted[..2], [(35, 24), (117, 96)]);
+        assert_eq!(counted[2], (25 * 17, 384));
     }
 
     #[test]

@@ -25,13 +25,18 @@ enum Command {
     /// Solve the problem a TOML problem file describes; write VTK, summary.json and CSV files.
     Run {
         /// The problem file (see meshes/*.toml).
-        problem: PathBuf,
+        problem: Option<PathBuf>,
         /// Output folder (default: next to the problem file, named after it).
         #[arg(long)]
         out: Option<PathBuf>,
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        /// Also solve on the mesh refined LEVELS times (default 1; each cell into 4 every time) at
+        /// the same load steps, and report the Richardson estimate of the mesh-converged results
+        /// and each run's estimated error (the refined runs' outputs go to OUT/refined/, ...).
+        #[arg(long, value_name = "LEVELS", num_args = 0..=1, default_missing_value = "1")]
+        refine: Option<String>,
     },
     /// Read and build a problem file, say what is wrong with it (rigid motions held by nothing,
     /// a punch starting inside the plate, empty groups; warnings for punches that move away or sit
@@ -68,7 +73,10 @@ fn main() -> ExitCode {
     let result = match cli.command {
         None => stamp_cli::paper::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
-        Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
+        Some(Command::Run { problem, out, quiet, refine }) => match stamp_cli::run::refine::levels_and_problem(refine.as_deref(), problem) {
+            Ok((levels, problem)) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet, levels),
+            Err(e) => Err(e),
+        },
         Some(Command::Check { problem }) => stamp_cli::run::check_command(&problem),
         Some(Command::Bench { one: Some(n), reuse, symmetric_part, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part }),
         Some(Command::Bench { sizes, json, reuse, symmetric_part, one: None }) => {
