@@ -206,7 +206,8 @@ fn table_history_and_summary_agree_with_the_refined_run() {
         assert!((row[col(&h, "sphere_force_refined_error_pct")] - 100.0 * (f1 - est) / est.abs()).abs() < 1e-6);
         // the table's row shows the same numbers
         let cells: Vec<&str> = table[head + 1 + i].split_whitespace().collect();
-        assert!(cells.contains(&format!("{:+.3}", pct).as_str()), "step {}: {pct:+.3} not in {:?}", i + 1, cells);
+        let text = stamp_cli::run::refine_report::percent(Some(pct));
+        assert!(cells.contains(&text.as_str()), "step {}: {text} not in {:?}", i + 1, cells);
         // the largest deflection is the plate centre's (corner_ll of the quarter)
         assert!((row[col(&h, "max_deflection")] - row[col(&h, "corner_ll_u3")]).abs() < 1e-12, "step {}", i + 1);
         // the contact force converges from above: the finer mesh is softer

@@ -82,8 +82,13 @@ pub fn run_command(problem: &Path, out: Option<&Path>, quiet: bool, refine: Opti
         Some(levels) => refine::run_refined(problem, out, quiet, levels)?,
     };
     if !quiet {
+        let refined = match refine {
+            Some(1) => format!("; the refined mesh's in {}", outcome.out_dir.join(refine::level_folder(1)).display()),
+            Some(n) => format!("; the refined meshes' in {} ... {}", outcome.out_dir.join(refine::level_folder(1)).display(), refine::level_folder(n)),
+            None => String::new(),
+        };
         println!(
-            "stamp run: {} converged steps; results in {} (summary.json, .pvd/.vtu, CSV)",
+            "stamp run: {} converged steps; results in {} (summary.json, .pvd/.vtu, CSV){refined}",
             outcome.converged_steps,
             outcome.out_dir.display()
         );

@@ -246,8 +246,12 @@ pub fn times(level: usize) -> String {
     }
 }
 
-fn percent(p: Option<f64>) -> String {
+/// A percentage in the table: three decimals ("+1.234"), tiny ones in exponent form ("+4.5e-4"),
+/// "-" when there is none (the estimate is 0 and the value is not).
+pub fn percent(p: Option<f64>) -> String {
     match p {
+        Some(x) if x == 0.0 => "0".into(),
+        Some(x) if x.is_finite() && x.abs() < 0.01 => format!("{x:+.1e}"),
         Some(x) if x.is_finite() => format!("{x:+.3}"),
         _ => "-".into(),
     }
