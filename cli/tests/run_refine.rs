@@ -304,3 +304,27 @@ fn a_gmsh_mesh_refines_with_its_groups() {
     assert!(f1 < f0 && (f0 - f1) / f0 < 0.03, "{f0} -> {f1}");
     assert!((est - 404.44).abs() < (f1 - 404.44).abs(), "estimate {est} not closer to 404.44 than the refined {f1}");
 }
+
+#[test]
+fn a_failed_refined_run_is_told_in_summary_json() {
+    // a file where the refined run's folder should go: the refined run cannot write
+    let dir = temp_dir("refine-fails");
+    let path = dir.join("plate.toml");
+    std::fs::write(&path, navier_plate(4)).unwrap();
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("refined"), "not a folder").unwrap();
+    let o = stamp(&["--refine", "-q"], &path, &out);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{e}");
+    assert!(e.contains("the mesh refined once") && e.contains("plate.toml"), "{e}");
+    let s = summary(&out);
+    assert_eq!(s["status"], "failed");
+    assert!(s["error"].as_str().unwrap().contains("the mesh refined once"), "{}", s["error"]);
+    assert_eq!(s["refinement"]["status"], "failed: the mesh refined once");
+    assert!(s["refinement"].get("steps").is_none(), "no estimates without the refined run");
+    // the run on the problem's mesh itself is complete
+    assert_eq!(s["steps"].as_array().unwrap().len(), 2);
+    let (h, _) = read_csv(&out.join("history.csv"));
+    assert!(!h.iter().any(|c| c.ends_with("_estimate")), "{h:?}");
+}
