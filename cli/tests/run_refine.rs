@@ -238,10 +238,10 @@ fn bad_levels_are_refused_clearly() {
     let dir = temp_dir("refine-bad");
     let path = dir.join("plate.toml");
     std::fs::write(&path, navier_plate(4)).unwrap();
-    for levels in ["0", "4", "many"] {
+    for levels in ["0", "4", "300"] {
         let o = stamp(&["--refine", levels], &path, &dir.join("out"));
         let e = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success() && e.contains("--refine takes 1 to 3 levels") && e.contains(levels), "{levels}: {e}");
+        assert!(!o.status.success() && e.contains(&format!("invalid value '{levels}' for '--refine")) && e.contains("1..=3"), "{levels}: {e}");
     }
     assert!(!dir.join("out").exists(), "nothing is written");
 }

@@ -22,29 +22,29 @@ use super::units::Units;
 use serde_json::{json, Value};
 use stamp::io::write_string_atomically;
 use stamp::{Result, StampError};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// The most refinements asked for at once (each multiplies the unknowns by 4).
 pub const MAX_LEVELS: usize = 3;
 
-/// The levels and the problem file of `stamp run [--refine [LEVELS]] PROBLEM`: `--refine` takes an
-/// optional number, so in `stamp run --refine P.toml` the parser hands the problem file over as
-/// the value of `--refine`.
-pub fn levels_and_problem(refine: Option<&str>, problem: Option<PathBuf>) -> Result<(Option<usize>, PathBuf)> {
-    let missing = || StampError::Problem("stamp run: the problem file is missing (stamp run [--refine [LEVELS]] PROBLEM.toml)".into());
-    let bad = |v: &str| StampError::Problem(format!("--refine takes 1 to {MAX_LEVELS} levels, got '{}'", stamp::quote(v)));
-    match (refine, problem) {
-        (None, Some(p)) => Ok((None, p)),
-        (None, None) => Err(missing()),
-        (Some(v), problem) => match (v.parse::<usize>(), problem) {
-            (Ok(n), Some(p)) if (1..=MAX_LEVELS).contains(&n) => Ok((Some(n), p)),
-            (Ok(_), Some(_)) => Err(bad(v)),
-            (Ok(_), None) => Err(missing()),
-            (Err(_), None) => Ok((Some(1), PathBuf::from(v))),
-            (Err(_), Some(_)) => Err(bad(v)),
-        },
+/// The command line with `--refine N` (N a whole number) joined into `--refine=N`: `--refine`
+/// takes an optional value, which must follow an `=` so that `stamp run --refine P.toml` leaves
+/// the problem file alone; `stamp run --refine 2 P.toml` still reads as two levels.
+pub fn join_refine_value<I: IntoIterator<Item = std::ffi::OsString>>(args: I) -> Vec<std::ffi::OsString> {
+    let mut out: Vec<std::ffi::OsString> = Vec::new();
+    let mut args = args.into_iter().peekable();
+    while let Some(a) = args.next() {
+        let number = args.peek().and_then(|n| n.to_str()).is_some_and(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit()));
+        if a == "--refine" && number {
+            let mut joined = std::ffi::OsString::from("--refine=");
+            joined.push(args.next().expect("peeked"));
+            out.push(joined);
+        } else {
+            out.push(a);
+        }
     }
+    out
 }
 
 /// The subfolder of the output folder for refinement level `level` (1-based).
@@ -219,18 +219,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn refine_takes_an_optional_number_before_the_problem() {
-        let p = |s: &str| Some(PathBuf::from(s));
-        assert_eq!(levels_and_problem(None, p("a.toml")).unwrap(), (None, PathBuf::from("a.toml")));
-        assert_eq!(levels_and_problem(Some("a.toml"), None).unwrap(), (Some(1), PathBuf::from("a.toml")));
-        assert_eq!(levels_and_problem(Some("1"), p("a.toml")).unwrap(), (Some(1), PathBuf::from("a.toml")));
-        assert_eq!(levels_and_problem(Some("2"), p("a.toml")).unwrap(), (Some(2), PathBuf::from("a.toml")));
-        for bad in ["0", "4", "two"] {
-            let e = levels_and_problem(Some(bad), p("a.toml")).unwrap_err().to_string();
-            assert!(e.contains("--refine takes 1 to 3 levels") && e.contains(bad), "{e}");
-        }
-        assert!(levels_and_problem(Some("2"), None).unwrap_err().to_string().contains("problem file is missing"));
-        assert!(levels_and_problem(None, None).is_err());
+    fn a_number_after_refine_is_its_value() {
+        let args = |v: &[&str]| v.iter().map(std::ffi::OsString::from).collect::<Vec<_>>();
+        assert_eq!(join_refine_value(args(&["stamp", "run", "--refine", "2", "a.toml"])), args(&["stamp", "run", "--refine=2", "a.toml"]));
+        assert_eq!(join_refine_value(args(&["stamp", "run", "--refine", "a.toml"])), args(&["stamp", "run", "--refine", "a.toml"]));
+        assert_eq!(join_refine_value(args(&["stamp", "run", "a.toml", "--refine"])), args(&["stamp", "run", "a.toml", "--refine"]));
+        assert_eq!(join_refine_value(args(&["stamp", "run", "--refine", "17", "a.toml"])), args(&["stamp", "run", "--refine=17", "a.toml"]));
+        assert_eq!(join_refine_value(args(&["stamp", "run", "--out", "2", "a.toml"])), args(&["stamp", "run", "--out", "2", "a.toml"]));
     }
 
     #[test]
