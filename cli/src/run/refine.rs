@@ -198,7 +198,7 @@ pub fn explanation(levels: usize) -> String {
         format!(
             "refined: the same steps on the mesh refined once (each cell into 4); estimate: Richardson extrapolation \
              F_refined + (F_refined - F) / (2^p - 1) with the element's order p = {} assumed (contact forces on coarse \
-             meshes often converge more slowly, p = 1 .. 1.5: then the error is up to about 1.5 times the estimate; \
+             meshes often converge more slowly, p = 1 .. 1.5: then the error is up to about 1.6 times the estimated one; \
              --refine 2 observes p); error %: each run's estimated error, 100 (F - estimate) / |estimate|",
             super::richardson::ASSUMED_ORDER
         )

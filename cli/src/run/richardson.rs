@@ -11,7 +11,7 @@
 /// converge more slowly: the simply supported quarter plate under a sphere, force at travel 0.9,
 /// observed order 1.08 on 10 x 10, 20 x 20, 40 x 40 and 1.44 on 20 x 20 .. 80 x 80 (other
 /// examples 0.9 .. 3.3), so with one refinement the estimate can understate their error by up to
-/// about 1.5 times; `--refine 2` observes the order.
+/// about 1.6 times; `--refine 2` observes the order.
 pub const ASSUMED_ORDER: f64 = 2.0;
 /// Observed orders outside [MIN_OBSERVED, MAX_OBSERVED] are not trusted (the meshes are not in the
 /// asymptotic range, or the differences are round-off).
