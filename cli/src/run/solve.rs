@@ -35,7 +35,8 @@ pub struct RunOutcome {
 pub struct SolveOptions {
     /// No progress bar, no table.
     pub quiet: bool,
-    /// Leave the end-of-run table to the caller (who prints its own).
+    /// Leave the end-of-run table of a converged run to the caller (who prints its own); a failed
+    /// run prints its table of the converged steps all the same.
     pub no_table: bool,
     /// Pass through exactly these load factors instead of the problem's targets (every one is a
     /// target: the outputs are written at each).
@@ -455,7 +456,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     if let Err(e) = finals {
         failure = failure.or(Some(e));
     }
-    if !quiet && !opts.no_table {
+    if !quiet && (!opts.no_table || failure.is_some()) {
         print!("{}", super::table::render(&history, &units));
     }
     summary.seconds = start.elapsed().as_secs_f64();
