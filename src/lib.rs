@@ -11,6 +11,7 @@ pub mod error;
 pub mod io;
 pub mod mesh;
 pub mod mesh_check;
+pub mod mesh_refine;
 pub mod surface;
 
 pub use error::{quote, Result, StampError};

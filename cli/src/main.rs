@@ -32,6 +32,11 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        /// Also solve on the mesh refined LEVELS times (default 1; each cell into 4 every time) at
+        /// the same load steps, and report the Richardson estimate of the mesh-converged results
+        /// and each run's estimated error (the refined runs' outputs go to OUT/refined/, ...).
+        #[arg(long, value_name = "LEVELS", num_args = 0..=1, require_equals = true, default_missing_value = "1", value_parser = clap::value_parser!(u8).range(1..=3))]
+        refine: Option<u8>,
     },
     /// Read and build a problem file, say what is wrong with it (rigid motions held by nothing,
     /// a punch starting inside the plate, empty groups; warnings for punches that move away or sit
@@ -64,11 +69,12 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // `--refine 2 P.toml` is read as `--refine=2 P.toml`, `--refine P.toml` as `--refine=1 P.toml`
+    let cli = Cli::parse_from(stamp_cli::run::refine::join_refine_value(std::env::args_os()));
     let result = match cli.command {
         None => stamp_cli::paper::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
-        Some(Command::Run { problem, out, quiet }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet),
+        Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
         Some(Command::Check { problem }) => stamp_cli::run::check_command(&problem),
         Some(Command::Bench { one: Some(n), reuse, symmetric_part, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part }),
         Some(Command::Bench { sizes, json, reuse, symmetric_part, one: None }) => {

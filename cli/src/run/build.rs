@@ -134,11 +134,18 @@ pub fn build(p: &Problem) -> Result<Setup> {
         StampError::Mesh(m) => p.error_at(s.mesh.span(), "mesh", m),
         e => e,
     })?;
-    let n_nodes = mesh.mesh.num_nodes();
     // a gmsh mesh is read first (its size bounded by its file); refuse it before the model is built
     if let Some(file) = &s.mesh.get_ref().file {
-        super::memory::check_model_fits(n_nodes as u64).map_err(|m| p.error_at(file.span(), "mesh.file", m))?;
+        super::memory::check_model_fits(mesh.mesh.num_nodes() as u64).map_err(|m| p.error_at(file.span(), "mesh.file", m))?;
     }
+    build_on(p, mesh)
+}
+
+/// Build everything the solve needs on the given mesh (the problem's own, or its refinement: the
+/// caller has checked that it fits in memory).
+pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
+    let s = &p.spec;
+    let n_nodes = mesh.mesh.num_nodes();
 
     // plate
     let ps = s.plate.get_ref();

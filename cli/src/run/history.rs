@@ -39,6 +39,8 @@ pub struct HistoryRow {
     pub punches: Vec<PunchRow>,
     /// Mid-surface displacement of each named point group (mean over its nodes).
     pub points: Vec<[f64; 3]>,
+    /// The mid-surface deflection u3 of largest magnitude over all nodes (with its sign).
+    pub max_deflection: f64,
 }
 
 /// The direction along which a punch's travel and force are measured.
@@ -82,6 +84,7 @@ pub fn mid_displacement(u: &[f64], n: usize) -> [f64; 3] {
 }
 
 /// The rows of a run so far and what names its columns.
+#[derive(Debug, Clone)]
 pub struct History {
     pub punch_names: Vec<String>,
     pub punch_faces: Vec<Face>,
@@ -123,7 +126,10 @@ impl History {
                 s
             })
             .collect();
-        self.rows.push(HistoryRow { step, load_factor: t, path, newton_iterations, punches, points });
+        // u holds six face displacements per node, then one unknown per force-driven punch
+        let nodes = (u.len() - contacts.iter().filter(|c| c.drive.is_some()).count()) / 6;
+        let max_deflection = (0..nodes).map(|n| mid_displacement(u, n)[2]).fold(0.0f64, |m, w| if w.abs() > m.abs() { w } else { m });
+        self.rows.push(HistoryRow { step, load_factor: t, path, newton_iterations, punches, points, max_deflection });
         self.rows.last().expect("just pushed")
     }
 

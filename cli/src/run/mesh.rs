@@ -76,6 +76,40 @@ impl MeshData {
         }
     }
 
+    /// The uniform refinement of this mesh ([`stamp::mesh_refine`]: every cell into four at its edge
+    /// midpoints and centre). Point groups keep their nodes, curves are cut at the midpoints of
+    /// their segments, surfaces get the four children of each cell; the node groups of curves and
+    /// points are rebuilt from those. New nodes have gmsh tag 0; a cell keeps the tag of the
+    /// element it was cut from.
+    pub fn refined(&self) -> MeshData {
+        let r = stamp::mesh_refine::refine(&self.mesh);
+        let curves: BTreeMap<String, Vec<[usize; 2]>> = self.curves.iter().map(|(k, s)| (k.clone(), r.segments(s))).collect();
+        let surfaces = self.surfaces.iter().map(|(k, c)| (k.clone(), r.cells(c))).collect();
+        let mut mesh = r.mesh.clone();
+        for (k, segs) in &curves {
+            if mesh.node_groups.contains_key(k) && !self.surfaces.contains_key(k) {
+                let mut v: Vec<usize> = segs.iter().flatten().copied().collect();
+                // a name used by a point group as well holds both (as the gmsh reader does)
+                v.extend(self.points.get(k).into_iter().flatten());
+                v.sort_unstable();
+                v.dedup();
+                mesh.node_groups.insert(k.clone(), v);
+            }
+        }
+        for (k, nodes) in &self.points {
+            if !curves.contains_key(k) && !self.surfaces.contains_key(k) && mesh.node_groups.contains_key(k) {
+                mesh.node_groups.insert(k.clone(), nodes.clone());
+            }
+        }
+        let node_tags = self.node_tags.as_ref().map(|t| {
+            let mut v = t.clone();
+            v.resize(mesh.num_nodes(), 0);
+            v
+        });
+        let cell_tags = self.cell_tags.as_ref().map(|t| r.cell_values(t));
+        MeshData { mesh, points: self.points.clone(), curves, surfaces, node_tags, cell_tags, split: self.split.clone() }
+    }
+
     /// Every group name, for error messages.
     pub fn all_names(&self) -> String {
         let mut v: Vec<String> = Vec::new();

@@ -8,6 +8,8 @@
 //! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those);
 //! * [`solve`]: Newton-Raphson along the targets with a progress bar, writing every step;
 //! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step;
+//! * [`refine`]: `stamp run --refine`, the run on refined meshes, with [`richardson`] and
+//!   [`refine_report`] (the estimates in the table, history.csv and summary.json);
 //! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in [`crate::paper`]).
 
 pub mod build;
@@ -21,6 +23,9 @@ pub mod plot;
 pub mod probe;
 pub mod problem;
 pub mod punch_start;
+pub mod refine;
+pub mod refine_report;
+pub mod richardson;
 pub mod rigid_modes;
 pub mod solve;
 pub mod table;
@@ -44,7 +49,7 @@ pub fn run(problem: &Path, out: Option<&Path>, quiet: bool) -> stamp::Result<Run
         eprintln!("warning: {w}");
     }
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
-    let outcome = solve::solve_and_write(&p, setup, &out_dir, quiet);
+    let outcome = solve::solve_and_write(&p, setup, &out_dir, &solve::SolveOptions { quiet, ..Default::default() });
     for w in check::never_touched(&p, &out_dir.join("summary.json")) {
         eprintln!("warning: {w}");
     }
@@ -69,12 +74,21 @@ pub fn check_command(problem: &Path) -> stamp::Result<()> {
     Ok(())
 }
 
-/// Run the problem file `problem`, writing into `out`.
-pub fn run_command(problem: &Path, out: Option<&Path>, quiet: bool) -> stamp::Result<()> {
-    let outcome = run(problem, out, quiet)?;
+/// Run the problem file `problem`, writing into `out`; with `refine` = Some(levels) also on the mesh
+/// refined `levels` times (see [`refine`]).
+pub fn run_command(problem: &Path, out: Option<&Path>, quiet: bool, refine: Option<usize>) -> stamp::Result<()> {
+    let outcome = match refine {
+        None => run(problem, out, quiet)?,
+        Some(levels) => refine::run_refined(problem, out, quiet, levels)?,
+    };
     if !quiet {
+        let refined = match refine {
+            Some(1) => format!("; the refined mesh's in {}", outcome.out_dir.join(refine::level_folder(1)).display()),
+            Some(n) => format!("; the refined meshes' in {} ... {}", outcome.out_dir.join(refine::level_folder(1)).display(), refine::level_folder(n)),
+            None => String::new(),
+        };
         println!(
-            "stamp run: {} converged steps; results in {} (summary.json, .pvd/.vtu, CSV)",
+            "stamp run: {} converged steps; results in {} (summary.json, .pvd/.vtu, CSV){refined}",
             outcome.converged_steps,
             outcome.out_dir.display()
         );

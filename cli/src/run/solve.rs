@@ -4,6 +4,7 @@
 use super::build::Setup;
 use super::output::{contact_csv, step_data, Context};
 use super::history::History;
+use serde_json::Value;
 use super::probe::Probes;
 use super::problem::{PlotAxis, Problem};
 use super::units::Units;
@@ -25,6 +26,25 @@ pub struct RunOutcome {
     pub summary: PathBuf,
     pub converged_steps: usize,
     pub files: Vec<PathBuf>,
+    /// The converged steps' punch forces, travels and deflections.
+    pub history: History,
+}
+
+/// How [`solve_and_write`] runs beyond the problem file.
+#[derive(Debug, Clone, Default)]
+pub struct SolveOptions {
+    /// No progress bar, no table.
+    pub quiet: bool,
+    /// Leave the end-of-run table of a converged run to the caller (who prints its own); a failed
+    /// run prints its table of the converged steps all the same.
+    pub no_table: bool,
+    /// Pass through exactly these load factors instead of the problem's targets (every one is a
+    /// target: the outputs are written at each).
+    pub targets: Option<Vec<f64>>,
+    /// summary.json's "refinement" object while the run goes on.
+    pub refinement: Option<Value>,
+    /// The caller finishes summary.json after a converged run: its status stays "running".
+    pub caller_finishes: bool,
 }
 
 #[derive(Serialize)]
@@ -71,6 +91,9 @@ struct Summary {
     seconds: f64,
     point_arrays: Vec<String>,
     cell_arrays: Vec<String>,
+    /// `stamp run --refine`: the meshes and the estimates (see refine.rs); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    refinement: Option<Value>,
     /// One entry per converged load step whose files were all written (the .pvd lists the same
     /// steps); a Newton failure adds a last entry with converged = false.
     steps: Vec<serde_json::Value>,
@@ -192,12 +215,14 @@ pub fn default_out_dir(problem: &Path) -> PathBuf {
 }
 
 /// Solve the problem and write every output into `out_dir`.
-pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -> Result<RunOutcome> {
+pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOptions) -> Result<RunOutcome> {
+    let quiet = opts.quiet;
     let start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
     // removes the previous run's files; records this run's when dropped (see out_dir.rs)
     let _folder = super::out_dir::RunFolder::claim(out_dir)?;
     let Setup { mesh, mut model, section, punches, targets, settings } = setup;
+    let targets = opts.targets.clone().unwrap_or(targets);
     let out = &p.spec.output;
     let stem = p.path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "step".into());
     let path_end = targets.iter().fold((0.0, 0.0), |(len, last), &t| (len + (t - last).abs(), t)).0.max(f64::MIN_POSITIVE);
@@ -275,6 +300,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
         seconds: 0.0,
         point_arrays: super::output::POINT_ARRAYS.iter().filter(|n| **n != "gap" || !punches.is_empty()).map(|s| s.to_string()).collect(),
         cell_arrays: super::output::CELL_ARRAYS.iter().map(|s| s.to_string()).collect(),
+        refinement: opts.refinement.clone(),
         steps: Vec::new(),
     };
     let summary_path = out_dir.join("summary.json");
@@ -430,11 +456,12 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     if let Err(e) = finals {
         failure = failure.or(Some(e));
     }
-    if !quiet {
+    if !quiet && (!opts.no_table || failure.is_some()) {
         print!("{}", super::table::render(&history, &units));
     }
     summary.seconds = start.elapsed().as_secs_f64();
     match &failure {
+        None if opts.caller_finishes => {}
         None => summary.status = "converged".into(),
         Some(e) => {
             summary.status = "failed".into();
@@ -446,6 +473,6 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, quiet: bool) -
     let converged_steps = summary.steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).count();
     match failure {
         Some(e) => Err(e),
-        None => Ok(RunOutcome { out_dir: out_dir.to_path_buf(), summary: summary_path, converged_steps, files }),
+        None => Ok(RunOutcome { out_dir: out_dir.to_path_buf(), summary: summary_path, converged_steps, files, history }),
     }
 }

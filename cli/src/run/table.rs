@@ -9,19 +9,26 @@ use super::units::Units;
 /// One number of a punch's row.
 type Quantity = fn(&super::history::PunchRow) -> f64;
 
-/// One column: the punch's name over its first column (else empty), the header, the values.
-struct Column {
-    group: String,
-    header: String,
-    values: Vec<String>,
+/// One column: the punch's name over its first column (else empty), the header, the values (one
+/// per row of the history).
+pub struct Column {
+    pub group: String,
+    pub header: String,
+    pub values: Vec<String>,
 }
 
-fn column(group: String, header: impl Into<String>, values: Vec<String>) -> Column {
+/// A column of the table.
+pub fn column(group: String, header: impl Into<String>, values: Vec<String>) -> Column {
     Column { group, header: header.into(), values }
 }
 
 /// The table text (ends with a newline; empty when no step converged).
 pub fn render(h: &History, units: &Units) -> String {
+    render_with(h, units, Vec::new())
+}
+
+/// The table with `extra` columns after the Newton iterations (`stamp run --refine`).
+pub fn render_with(h: &History, units: &Units, extra: Vec<Column>) -> String {
     if h.rows.is_empty() {
         return String::new();
     }
@@ -42,6 +49,7 @@ pub fn render(h: &History, units: &Units) -> String {
         }
     }
     cols.push(column(String::new(), "Newton", h.rows.iter().map(|r| r.newton_iterations.to_string()).collect()));
+    cols.extend(extra);
     let widths: Vec<usize> = cols.iter().map(|c| c.values.iter().map(|s| s.len()).chain([c.header.chars().count(), c.group.chars().count()]).max().unwrap_or(0)).collect();
     let mut out = String::new();
     if cols.iter().any(|c| !c.group.is_empty()) {
@@ -77,6 +85,7 @@ mod tests {
                 newton_iterations: 4 + k,
                 punches: vec![PunchRow { travel: 0.5 * t, force: 500.0 * t, contact_area: 3.0, max_pressure: 12.5, max_penetration: 1e-7 }],
                 points: vec![],
+                max_deflection: -0.1 * t,
             });
         }
         let units = Units { length: "mm".into(), force: "N".into(), pressure: "MPa".into(), area: "mm^2".into(), length_given: true, force_given: true };
