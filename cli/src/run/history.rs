@@ -180,17 +180,24 @@ impl History {
     }
 
     /// Draw force against travel for every punch: `force_travel_<punch>.png` and `.svg` (against the
-    /// load factor for a punch whose travel stays 0: a fixed punch).
+    /// load factor for a punch whose travel stays 0, a fixed punch, and for one whose travel stays
+    /// the same over a step while it moves on: a die sliding along a path).
     pub fn plot_force_travel(&self, dir: &Path, units: &Units) -> Result<Vec<PathBuf>> {
         let mut files = Vec::new();
         for (k, name) in self.punch_names.iter().enumerate() {
             // a punch that does not move: force against the load factor
             let fixed = self.rows.iter().all(|r| r.punches[k].travel == 0.0);
+            let scale = self.rows.iter().map(|r| r.punches[k].travel.abs()).fold(0.0, f64::max);
+            let slides = !fixed
+                && self.rows.windows(2).any(|w| (w[1].punches[k].travel - w[0].punches[k].travel).abs() <= 1e-12 * scale && w[1].load_factor != w[0].load_factor);
+            let against_load_factor = fixed || slides;
             let mut points = vec![(0.0, 0.0)];
-            points.extend(self.rows.iter().map(|r| (if fixed { r.load_factor } else { r.punches[k].travel }, r.punches[k].force)));
+            points.extend(self.rows.iter().map(|r| (if against_load_factor { r.load_factor } else { r.punches[k].travel }, r.punches[k].force)));
             let series = [Series { label: String::new(), points: points.clone(), markers: points }];
             let (title, x) = if fixed {
                 (format!("punch '{name}' (fixed): force against load factor"), "load factor".to_string())
+            } else if slides {
+                (format!("punch '{name}' (moved along a path): force against load factor"), "load factor".to_string())
             } else {
                 (format!("punch '{name}': force against travel"), Units::label("travel", &units.length))
             };
@@ -241,5 +248,32 @@ mod tests {
         assert_eq!(sig(123456789.0), "1.23457e8");
         assert_eq!(sig(99.9999999873), "100.000");
         assert_eq!(sig(999999.9), "1.00000e6");
+    }
+
+    /// The force-travel plot's title for a punch with these (load factor, travel) steps.
+    fn plot_title(name: &str, steps: &[(f64, f64)]) -> String {
+        let mut h = History::new(&[(name.into(), Face::Top, false)], &[]);
+        for (k, &(t, travel)) in steps.iter().enumerate() {
+            let punches = vec![PunchRow { travel, force: 10.0 * t, contact_area: 1.0, max_pressure: 1.0, max_penetration: 0.0 }];
+            h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0 });
+        }
+        let dir = std::env::temp_dir().join(format!("stamp-history-plot-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        h.plot_force_travel(&dir, &Units::new(None)).unwrap();
+        let svg = std::fs::read_to_string(dir.join(format!("force_travel_{name}.svg"))).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        svg
+    }
+
+    #[test]
+    fn a_sliding_punch_is_plotted_against_the_load_factor() {
+        // pressed, then slid at the same depth: its travel stands still while the load factor goes on
+        let svg = plot_title("slide", &[(0.25, 0.1), (0.5, 0.2), (0.75, 0.2), (1.0, 0.2)]);
+        assert!(svg.contains("moved along a path): force against load factor"), "{svg}");
+        // pressed and released: force against travel (a loop is what the user wants to see)
+        let svg = plot_title("press", &[(0.5, 0.1), (1.0, 0.2), (1.5, 0.1), (2.0, 0.0)]);
+        assert!(svg.contains("force against travel"), "{svg}");
+        let svg = plot_title("fixed", &[(0.5, 0.0), (1.0, 0.0)]);
+        assert!(svg.contains("(fixed): force against load factor"), "{svg}");
     }
 }
