@@ -24,23 +24,6 @@ fn check(file: &Path) -> Out {
     stamp(&["check"], file)
 }
 
-/// A shipped problem file with some text replaced, written to a fresh folder (the mesh files of
-/// meshes/ copied along).
-fn variant(name: &str, shipped: &str, edits: &[(&str, &str)]) -> PathBuf {
-    let dir = temp_dir(name);
-    let mut text = std::fs::read_to_string(repo().join("meshes").join(shipped)).unwrap();
-    for (from, to) in edits {
-        assert!(text.contains(from), "{shipped} has no '{from}'");
-        text = text.replacen(from, to, 1);
-    }
-    for msh in ["paper-r100.msh", "sphere-ss-full.msh", "sphere-demo.msh"] {
-        std::fs::copy(repo().join("meshes").join(msh), dir.join(msh)).unwrap();
-    }
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
 fn write(name: &str, files: &[(&str, &str)]) -> PathBuf {
     let dir = temp_dir(name);
     for (f, text) in files {

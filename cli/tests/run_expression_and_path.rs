@@ -19,19 +19,6 @@ fn stamp(args: &[&str], file: &Path) -> Out {
     Out { ok: o.status.success(), stderr: String::from_utf8_lossy(&o.stderr).into_owned() }
 }
 
-/// A shipped problem with some text replaced, in a fresh folder.
-fn variant(name: &str, shipped: &str, edits: &[(&str, &str)]) -> PathBuf {
-    let dir = temp_dir(name);
-    let mut text = std::fs::read_to_string(repo().join("meshes").join(shipped)).unwrap();
-    for (from, to) in edits {
-        assert!(text.contains(from), "{shipped} has no '{from}'");
-        text = text.replacen(from, to, 1);
-    }
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
 /// Runs a problem into `out` (which it creates) and returns the folder.
 fn run(problem: &Path, out: &str) -> PathBuf {
     let dir = temp_dir(out).join("out");

@@ -16,6 +16,26 @@ pub fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
+/// A shipped problem file (meshes/`shipped`) with some text replaced, written as `name`.toml to a
+/// fresh folder with the mesh and STL files of meshes/ beside it.
+pub fn variant(name: &str, shipped: &str, edits: &[(&str, &str)]) -> PathBuf {
+    let dir = temp_dir(name);
+    let mut text = std::fs::read_to_string(repo().join("meshes").join(shipped)).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{shipped} has no '{from}'");
+        text = text.replacen(from, to, 1);
+    }
+    for entry in std::fs::read_dir(repo().join("meshes")).unwrap() {
+        let path = entry.unwrap().path();
+        if matches!(path.extension().and_then(|e| e.to_str()), Some("msh" | "stl")) {
+            std::fs::copy(&path, dir.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
 /// A cantilever strip (Table 1's first row): plane strain, clamped at x2 = 0, an end force F per
 /// unit width at x2 = 100, no punch.
 pub const CANTILEVER: &str = r#"title = "cantilever"
