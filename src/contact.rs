@@ -233,7 +233,23 @@ pub struct ContactPair {
     /// The largest |lambda| seen in the current load step (the scale of "near the kink" for
     /// frozen points while every point is momentarily inactive).
     pub lambda_scale: f64,
+    /// Damped growth of the active set: in an evaluation with a tangent, a penetrating inactive
+    /// point enters the active set only where its trial multiplier lambda_bar + eps Psi is at
+    /// most `entry_fraction` times the most negative trial of the inactive points (the deepest
+    /// half of the new penetrations with the default [`ENTRY_FRACTION`]); the others count as
+    /// changes and enter at a later iteration if they still penetrate. 0: every penetrating
+    /// point enters at once (plain semi-smooth Newton). A Newton step from too small a set
+    /// leaves the plate free around it, so it penetrates the punch far beyond the contact zone
+    /// of the solution; taking all of that band in overshoots, and an overshooting set comes
+    /// back one ring of nodes per iteration (only its outermost ring turns tensile, the
+    /// multipliers inside a conforming zone being close to zero).
+    pub entry_fraction: f64,
+    /// The point kinematics of the last evaluation (scratch, reused).
+    kinematics_scratch: Vec<(f64, Vector3<f64>, f64, Option<Vector3<f64>>)>,
 }
+
+/// The default [`ContactPair::entry_fraction`].
+pub const ENTRY_FRACTION: f64 = 0.5;
 
 impl ContactPair {
     pub fn new(name: impl Into<String>, surface: Arc<dyn ContactSurface>, points: Vec<ContactPoint>, eps_reg: f64, kinematics: ContactKinematics) -> Self {
@@ -255,6 +271,8 @@ impl ContactPair {
             initialized: false,
             max_flips: 10,
             lambda_scale: 0.0,
+            entry_fraction: ENTRY_FRACTION,
+            kinematics_scratch: Vec::new(),
         }
     }
 
@@ -318,11 +336,14 @@ impl ContactPair {
         self.lambda_scale = self.lambda_scale.max(current);
         let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
         let mut any_tangent = false;
-        for (k, p) in self.points.iter().enumerate() {
+        // Psi, its gradient with respect to the point's displacement and to s, the Hessian point,
+        // for every point first (the entry rule below needs the deepest penetration)
+        let mut kin = std::mem::take(&mut self.kinematics_scratch);
+        kin.clear();
+        for p in &self.points {
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
-            // Psi, its gradient with respect to the point's displacement and to s, the Hessian point
-            let (psi, grad, grad_s, hess) = match self.kinematics {
+            let point = match self.kinematics {
                 ContactKinematics::Exact => {
                     let x = x_ref + disp - d;
                     let g = self.surface.gradient(&x);
@@ -339,13 +360,37 @@ impl ContactPair {
                     (self.surface.psi(&x0) + gn * disp.dot(&n) - g0.dot(&dn) * s, n * gn, -g0.dot(&dn), None)
                 }
             };
+            kin.push(point);
+        }
+        // Damped growth of the active set (see `entry_fraction`): in an evaluation with a tangent,
+        // an inactive point enters only where its trial multiplier is at or below entry_fraction
+        // times the most negative trial of the inactive points
+        let entry_cut = if with_tangent && !first && !self.hold_active_set && self.entry_fraction > 0.0 {
+            let deepest = kin
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| !self.last_active[*k] && !self.frozen[*k])
+                .map(|(k, q)| self.lambda_bar[k] + self.eps_reg * q.0)
+                .fold(0.0f64, f64::min);
+            self.entry_fraction * deepest
+        } else {
+            0.0
+        };
+        for (k, p) in self.points.iter().enumerate() {
+            let (psi, grad, grad_s, hess) = kin[k];
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
             // touching points (Psi = 0) belong to the active set
             let wanted = trial <= 0.0;
             if first {
                 self.last_active[k] = wanted;
             }
-            let active = if self.hold_active_set {
+            // a penetrating point held back by the entry rule: still a change (the step is not
+            // converged), but neither force nor tangent in this evaluation
+            let deferred = with_tangent && !self.hold_active_set && wanted && !self.last_active[k] && !self.frozen[k] && trial > entry_cut;
+            let active = if deferred {
+                changes += 1;
+                false
+            } else if self.hold_active_set {
                 // the paper's trial and error: the set stays fixed while Newton converges on it
                 if wanted != self.last_active[k] && !self.frozen[k] {
                     changes += 1;
@@ -427,6 +472,7 @@ impl ContactPair {
         if first {
             self.initialized = true;
         }
+        self.kinematics_scratch = kin;
         changes
     }
 
