@@ -638,3 +638,85 @@ mod motion_tests {
         assert!(PunchMotion::path(&[(0.0, [0.0; 3]), (1.0, [0.0, 0.0, -1.0])]).is_ok());
     }
 }
+
+#[cfg(test)]
+mod entry_tests {
+    //! The damped growth of the active set: which penetrating points enter in an evaluation with
+    //! a tangent, and that the held-back ones still count as changes until they are in.
+    use super::*;
+    use crate::surface::ContactSurface;
+
+    /// The punch's underside is the plane x3 = 0 (Psi = -x3: a point above it, x3 > 0, penetrates).
+    struct Plane;
+    impl ContactSurface for Plane {
+        fn psi(&self, x: &Vector3<f64>) -> f64 {
+            -x[2]
+        }
+        fn gradient(&self, _x: &Vector3<f64>) -> Vector3<f64> {
+            Vector3::new(0.0, 0.0, -1.0)
+        }
+    }
+
+    /// Four points at x3 = 0 below the plane (touching), each with its own dofs.
+    fn pair(entry_fraction: f64) -> ContactPair {
+        let points = (0..4).map(|k| ContactPoint { node: k, x_ref: [k as f64, 0.0, -1e-3], dofs: [3 * k, 3 * k + 1, 3 * k + 2], weight: 1.0 }).collect();
+        let mut pair = ContactPair::new("plane", Arc::new(Plane), points, 10.0, ContactKinematics::Exact);
+        pair.entry_fraction = entry_fraction;
+        pair
+    }
+
+    /// Evaluate with a tangent at the points' upward displacements `w` (x3 = -1e-3 + w);
+    /// returns the changes and the active flags.
+    fn evaluate(pair: &mut ContactPair, w: [f64; 4]) -> (usize, Vec<bool>) {
+        let mut u = vec![0.0; 12];
+        for k in 0..4 {
+            u[3 * k + 2] = w[k];
+        }
+        let mut force = vec![0.0; 12];
+        let mut add = |_: usize, _: usize, _: f64| {};
+        let changes = pair.evaluate(&u, 0.0, &mut force, Some(&mut add));
+        (changes, pair.state.iter().map(|s| s.active).collect())
+    }
+
+    #[test]
+    fn only_the_deepest_half_of_the_new_penetrations_enters() {
+        let mut p = pair(0.5);
+        // first evaluation: nothing touches
+        assert_eq!(evaluate(&mut p, [0.0; 4]), (0, vec![false; 4]));
+        // penetrations 1, 0.6, 0.4 and none (x3 = w - 1e-3): the deepest is 0.999, half of it
+        // 0.4995; 0.599 enters, 0.399 is held back but counts as a change
+        let w = [1.0, 0.6, 0.4, 0.0];
+        let (changes, active) = evaluate(&mut p, w);
+        assert_eq!(active, vec![true, true, false, false]);
+        assert_eq!(changes, 3, "two points entered, one is held back");
+        // the held-back point gets no force
+        assert_eq!(p.state[2].lambda, 0.0);
+        assert!(p.state[0].lambda < 0.0 && p.state[1].lambda < 0.0);
+        // next time it is the deepest of the inactive points: it enters, and then nothing changes
+        let (changes, active) = evaluate(&mut p, w);
+        assert_eq!((changes, active), (1, vec![true, true, true, false]));
+        assert_eq!(evaluate(&mut p, w).0, 0);
+    }
+
+    #[test]
+    fn with_entry_fraction_zero_every_penetrating_point_enters_at_once() {
+        let mut p = pair(0.0);
+        evaluate(&mut p, [0.0; 4]);
+        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]);
+        assert_eq!((changes, active), (3, vec![true, true, true, false]));
+    }
+
+    #[test]
+    fn a_residual_only_evaluation_reports_the_true_changes_and_holds_nothing_back() {
+        let mut p = pair(0.5);
+        evaluate(&mut p, [0.0; 4]);
+        let mut u = vec![0.0; 12];
+        u[2] = 1.0;
+        u[8] = 0.4;
+        let mut force = vec![0.0; 12];
+        // a line-search trial: the force of every penetrating point, nothing recorded
+        assert_eq!(p.evaluate(&u, 0.0, &mut force, None), 2);
+        assert!(force[8] != 0.0, "the shallow penetration acts in a residual-only evaluation");
+        assert_eq!(p.last_active, vec![false; 4]);
+    }
+}
