@@ -248,7 +248,23 @@ pub struct ContactPair {
     /// point stays where it was (Newton's next iteration starts where the line search's accepted
     /// trial evaluated).
     surface_at_points: Vec<SurfaceAtPoint>,
+    /// Damped growth of the active set: in an evaluation with a tangent, a penetrating inactive
+    /// point enters the active set only where its trial multiplier lambda_bar + eps Psi is at
+    /// most `entry_fraction` times the most negative trial of the inactive points (the deepest
+    /// half of the new penetrations with the default [`ENTRY_FRACTION`]); the others count as
+    /// changes and enter at a later iteration if they still penetrate. 0: every penetrating
+    /// point enters at once (plain semi-smooth Newton). A Newton step from too small a set
+    /// leaves the plate free around it, so it penetrates the punch far beyond the contact zone
+    /// of the solution; taking all of that band in overshoots, and an overshooting set comes
+    /// back one ring of nodes per iteration (only its outermost ring turns tensile, the
+    /// multipliers inside a conforming zone being close to zero).
+    pub entry_fraction: f64,
+    /// The point kinematics of the last evaluation (scratch, reused).
+    kinematics_scratch: Vec<(f64, Vector3<f64>, f64, Option<Vector3<f64>>)>,
 }
+
+/// The default [`ContactPair::entry_fraction`].
+pub const ENTRY_FRACTION: f64 = 0.5;
 
 impl ContactPair {
     pub fn new(name: impl Into<String>, surface: Arc<dyn ContactSurface>, points: Vec<ContactPoint>, eps_reg: f64, kinematics: ContactKinematics) -> Self {
@@ -271,6 +287,8 @@ impl ContactPair {
             max_flips: 10,
             lambda_scale: 0.0,
             surface_at_points: vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; n],
+            entry_fraction: ENTRY_FRACTION,
+            kinematics_scratch: Vec::new(),
         }
     }
 
@@ -347,11 +365,14 @@ impl ContactPair {
                 }
             });
         }
+        // Psi, its gradient with respect to the point's displacement and to s, the Hessian point,
+        // for every point first (the entry rule below needs the deepest penetration)
+        let mut kin = std::mem::take(&mut self.kinematics_scratch);
+        kin.clear();
         for (k, p) in self.points.iter().enumerate() {
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
-            // Psi, its gradient with respect to the point's displacement and to s, the Hessian point
-            let (psi, grad, grad_s, hess) = match self.kinematics {
+            let point = match self.kinematics {
                 ContactKinematics::Exact => {
                     let x = x_ref + disp - d;
                     let SurfaceAtPoint { psi, grad: g, .. } = self.surface_at_points[k];
@@ -368,13 +389,37 @@ impl ContactPair {
                     (self.surface.psi(&x0) + gn * disp.dot(&n) - g0.dot(&dn) * s, n * gn, -g0.dot(&dn), None)
                 }
             };
+            kin.push(point);
+        }
+        // Damped growth of the active set (see `entry_fraction`): in an evaluation with a tangent,
+        // an inactive point enters only where its trial multiplier is at or below entry_fraction
+        // times the most negative trial of the inactive points
+        let entry_cut = if with_tangent && !first && !self.hold_active_set && self.entry_fraction > 0.0 {
+            let deepest = kin
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| !self.last_active[*k] && !self.frozen[*k])
+                .map(|(k, q)| self.lambda_bar[k] + self.eps_reg * q.0)
+                .fold(0.0f64, f64::min);
+            self.entry_fraction * deepest
+        } else {
+            0.0
+        };
+        for (k, p) in self.points.iter().enumerate() {
+            let (psi, grad, grad_s, hess) = kin[k];
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
             // touching points (Psi = 0) belong to the active set
             let wanted = trial <= 0.0;
             if first {
                 self.last_active[k] = wanted;
             }
-            let active = if self.hold_active_set {
+            // a penetrating point held back by the entry rule: still a change (the step is not
+            // converged), but neither force nor tangent in this evaluation
+            let deferred = with_tangent && !self.hold_active_set && wanted && !self.last_active[k] && !self.frozen[k] && trial > entry_cut;
+            let active = if deferred {
+                changes += 1;
+                false
+            } else if self.hold_active_set {
                 // the paper's trial and error: the set stays fixed while Newton converges on it
                 if wanted != self.last_active[k] && !self.frozen[k] {
                     changes += 1;
@@ -456,6 +501,7 @@ impl ContactPair {
         if first {
             self.initialized = true;
         }
+        self.kinematics_scratch = kin;
         changes
     }
 
@@ -619,5 +665,87 @@ mod motion_tests {
         assert!(e(&[(0.0, [1.0, 0.0, 0.0])]).contains("at t = 0 the displacement must be [0, 0, 0]"));
         assert!(e(&[(1.0, [f64::NAN, 0.0, 0.0])]).contains("finite"));
         assert!(PunchMotion::path(&[(0.0, [0.0; 3]), (1.0, [0.0, 0.0, -1.0])]).is_ok());
+    }
+}
+
+#[cfg(test)]
+mod entry_tests {
+    //! The damped growth of the active set: which penetrating points enter in an evaluation with
+    //! a tangent, and that the held-back ones still count as changes until they are in.
+    use super::*;
+    use crate::surface::ContactSurface;
+
+    /// The punch's underside is the plane x3 = 0 (Psi = -x3: a point above it, x3 > 0, penetrates).
+    struct Plane;
+    impl ContactSurface for Plane {
+        fn psi(&self, x: &Vector3<f64>) -> f64 {
+            -x[2]
+        }
+        fn gradient(&self, _x: &Vector3<f64>) -> Vector3<f64> {
+            Vector3::new(0.0, 0.0, -1.0)
+        }
+    }
+
+    /// Four points at x3 = 0 below the plane (touching), each with its own dofs.
+    fn pair(entry_fraction: f64) -> ContactPair {
+        let points = (0..4).map(|k| ContactPoint { node: k, x_ref: [k as f64, 0.0, -1e-3], dofs: [3 * k, 3 * k + 1, 3 * k + 2], weight: 1.0 }).collect();
+        let mut pair = ContactPair::new("plane", Arc::new(Plane), points, 10.0, ContactKinematics::Exact);
+        pair.entry_fraction = entry_fraction;
+        pair
+    }
+
+    /// Evaluate with a tangent at the points' upward displacements `w` (x3 = -1e-3 + w);
+    /// returns the changes and the active flags.
+    fn evaluate(pair: &mut ContactPair, w: [f64; 4]) -> (usize, Vec<bool>) {
+        let mut u = vec![0.0; 12];
+        for k in 0..4 {
+            u[3 * k + 2] = w[k];
+        }
+        let mut force = vec![0.0; 12];
+        let mut add = |_: usize, _: usize, _: f64| {};
+        let changes = pair.evaluate(&u, 0.0, &mut force, Some(&mut add));
+        (changes, pair.state.iter().map(|s| s.active).collect())
+    }
+
+    #[test]
+    fn only_the_deepest_half_of_the_new_penetrations_enters() {
+        let mut p = pair(0.5);
+        // first evaluation: nothing touches
+        assert_eq!(evaluate(&mut p, [0.0; 4]), (0, vec![false; 4]));
+        // penetrations 1, 0.6, 0.4 and none (x3 = w - 1e-3): the deepest is 0.999, half of it
+        // 0.4995; 0.599 enters, 0.399 is held back but counts as a change
+        let w = [1.0, 0.6, 0.4, 0.0];
+        let (changes, active) = evaluate(&mut p, w);
+        assert_eq!(active, vec![true, true, false, false]);
+        assert_eq!(changes, 3, "two points entered, one is held back");
+        // the held-back point gets no force
+        assert_eq!(p.state[2].lambda, 0.0);
+        assert!(p.state[0].lambda < 0.0 && p.state[1].lambda < 0.0);
+        // next time it is the deepest of the inactive points: it enters, and then nothing changes
+        let (changes, active) = evaluate(&mut p, w);
+        assert_eq!((changes, active), (1, vec![true, true, true, false]));
+        assert_eq!(evaluate(&mut p, w).0, 0);
+    }
+
+    #[test]
+    fn with_entry_fraction_zero_every_penetrating_point_enters_at_once() {
+        let mut p = pair(0.0);
+        evaluate(&mut p, [0.0; 4]);
+        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]);
+        assert_eq!((changes, active), (3, vec![true, true, true, false]));
+    }
+
+    #[test]
+    fn a_residual_only_evaluation_reports_the_true_changes_and_holds_nothing_back() {
+        let mut p = pair(0.5);
+        evaluate(&mut p, [0.0; 4]);
+        let mut u = vec![0.0; 12];
+        u[2] = 1.0;
+        u[8] = 0.4;
+        let mut force = vec![0.0; 12];
+        // a line-search trial: the force of every penetrating point, nothing recorded
+        assert_eq!(p.evaluate(&u, 0.0, &mut force, None), 2);
+        assert!(force[8] != 0.0, "the shallow penetration acts in a residual-only evaluation");
+        assert_eq!(p.last_active, vec![false; 4]);
     }
 }

@@ -2,6 +2,11 @@
 //! quarter model), solved on n x n structured meshes with the same loads at every size, timing
 //! each phase of the solve.
 //!
+//! Two problems ([`BenchProblem`]): the default one built here (side 100, R = 50, the sphere
+//! moved down 2 in one load target, growing increments), and `meshes/sphere-ss-displacement.toml`
+//! (side 40, R = 200, moved down 0.9 in 5 targets, augmented Lagrangian) built by `stamp run`'s
+//! own pipeline from that file with its mesh's `n` replaced, so that it is the users' problem.
+//!
 //! Every size runs in a child process of its own (`stamp bench --one N`), so that its peak
 //! resident memory is its own and no size warms the caches of the next.
 
@@ -32,6 +37,41 @@ pub const RADIUS: f64 = 50.0;
 pub const PUNCH_TRAVEL: f64 = 2.0;
 /// The default sizes of `stamp bench`.
 pub const DEFAULT_SIZES: [usize; 5] = [25, 50, 100, 200, 400];
+/// The default sizes of `stamp bench --problem sphere-displacement`.
+pub const DISPLACEMENT_SIZES: [usize; 5] = [10, 20, 40, 80, 160];
+
+/// Which problem `stamp bench` solves.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchProblem {
+    /// The sphere (R = 50) moved down 2 onto the plate of side 100, one load target (the default).
+    #[default]
+    Sphere,
+    /// `meshes/sphere-ss-displacement.toml`: the sphere (R = 200) moved down 0.9 onto the plate of
+    /// side 40 in 5 equal targets (max_increment 0.2), augmented Lagrangian to a penetration of 1e-6.
+    SphereDisplacement,
+}
+
+impl BenchProblem {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            BenchProblem::Sphere => "sphere",
+            BenchProblem::SphereDisplacement => "sphere-displacement",
+        }
+    }
+
+    /// The sizes `stamp bench` runs without --sizes.
+    pub fn default_sizes(self) -> &'static [usize] {
+        match self {
+            BenchProblem::Sphere => &DEFAULT_SIZES,
+            BenchProblem::SphereDisplacement => &DISPLACEMENT_SIZES,
+        }
+    }
+}
+
+/// The problem file of [`BenchProblem::SphereDisplacement`], its mesh line as in the file.
+const DISPLACEMENT_PROBLEM: &str = include_str!("../../meshes/sphere-ss-displacement.toml");
+const DISPLACEMENT_MESH_N: &str = "n = [10, 10]";
 
 /// Seconds spent in each phase.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
@@ -51,6 +91,9 @@ pub struct BenchRun {
     pub n: usize,
     pub unknowns: usize,
     pub steps: usize,
+    /// Load increments given up and cut back (failed attempts).
+    #[serde(default)]
+    pub cutbacks: usize,
     pub newton_iterations: usize,
     pub seconds: Seconds,
     pub peak_rss_bytes: u64,
@@ -123,9 +166,7 @@ pub fn peak_rss_bytes() -> u64 {
         .unwrap_or(0)
 }
 
-/// Solve one size in this process and time it. The deformed plate of the last step is written as
-/// a .vtu file into a temporary folder (timed as output) and removed.
-/// The linear solver's options of a benchmark run.
+/// The linear solver's options and the problem of a benchmark run.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SolverOptions {
     /// `LdltGmres::reuse`.
@@ -133,22 +174,43 @@ pub struct SolverOptions {
     /// Factorise the tangent's symmetric part instead of the plate's P
     /// (`LdltGmres::with_preconditioner(false)`).
     pub symmetric_part: bool,
+    /// The problem solved.
+    pub problem: BenchProblem,
 }
 
+/// The model, the load targets and the settings of `meshes/sphere-ss-displacement.toml` on an
+/// n x n mesh, built as `stamp run` builds them.
+fn build_displacement(n: usize) -> Result<(crate::run::build::Setup, Vec<f64>)> {
+    debug_assert!(DISPLACEMENT_PROBLEM.contains(DISPLACEMENT_MESH_N));
+    let source = DISPLACEMENT_PROBLEM.replacen(DISPLACEMENT_MESH_N, &format!("n = [{n}, {n}]"), 1);
+    let p = crate::run::Problem::parse(std::path::Path::new("meshes/sphere-ss-displacement.toml"), source)?;
+    let setup = crate::run::build::build(&p)?;
+    let targets = setup.targets.clone();
+    Ok((setup, targets))
+}
+
+/// Solve one size in this process and time it. The deformed plate of the last step is written as
+/// a .vtu file into a temporary folder (timed as output) and removed.
 pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
     if n == 0 {
         return Err(StampError::Problem("bench sizes must be positive".into()));
     }
     let start = Instant::now();
-    let mut model = build(n)?;
-    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(options.reuse).with_preconditioner(!options.symmetric_part), settings());
+    let (mut model, mesh, settings, targets) = match options.problem {
+        BenchProblem::Sphere => (build(n)?, QuadMesh::rectangle(0.0, 0.5 * SIDE, 0.0, 0.5 * SIDE, n, n)?, settings(), vec![1.0]),
+        BenchProblem::SphereDisplacement => {
+            let (setup, targets) = build_displacement(n)?;
+            (setup.model, setup.mesh.mesh, setup.settings, targets)
+        }
+    };
+    // (no force-driven punch in either problem: `stamp run`'s BorderedSolver would be this solver)
+    let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(options.reuse).with_preconditioner(!options.symmetric_part), settings);
     let mut u = vec![0.0; model.num_dofs()];
-    let summary = newton.solve_path(&mut model, &mut u, 0.0, &[1.0], &mut |_, _, _| {})?;
+    let summary = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |_, _, _| {})?;
 
     let t_out = Instant::now();
     let dir = std::env::temp_dir().join(format!("stamp-bench-{}-{n}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| StampError::io(&dir, e))?;
-    let mesh = QuadMesh::rectangle(0.0, 0.5 * SIDE, 0.0, 0.5 * SIDE, n, n)?;
     let nn = mesh.num_nodes();
     let mid: Vec<f64> = (0..nn).flat_map(|k| (0..3).map(move |c| (k, c))).map(|(k, c)| 0.5 * (u[6 * k + c] + u[6 * k + 3 + c])).collect();
     let pressure = model.contacts[0].pressures();
@@ -164,6 +226,7 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
         n,
         unknowns: model.num_equations(),
         steps: summary.steps,
+        cutbacks: summary.cutbacks,
         newton_iterations: summary.newton_iterations,
         seconds: Seconds {
             assembly: mt.assembly,
@@ -194,6 +257,7 @@ pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut
             .args(["bench", "--one", &n.to_string()])
             .args(if options.reuse { &["--reuse"][..] } else { &[][..] })
             .args(if options.symmetric_part { &["--symmetric-part"][..] } else { &[][..] })
+            .args(["--problem", options.problem.name()])
             .output()
             .map_err(|e| StampError::io(&exe, e))?;
         if !out.status.success() {
@@ -207,11 +271,15 @@ pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut
 }
 
 /// The table header of the text report.
-pub fn header() -> String {
+pub fn header(problem: BenchProblem) -> String {
+    let title = match problem {
+        BenchProblem::Sphere => format!("simply supported square plate (side {SIDE}, h = {THICKNESS}, quarter model) under a sphere (R = {RADIUS}, travel {PUNCH_TRAVEL})"),
+        BenchProblem::SphereDisplacement => "meshes/sphere-ss-displacement.toml: simply supported square plate (side 40, h = 1, quarter model) under a sphere (R = 200, travel 0.9, 5 targets)".into(),
+    };
     format!(
-        "stamp bench: simply supported square plate (side {SIDE}, h = {THICKNESS}, quarter model) under a sphere (R = {RADIUS}, travel {PUNCH_TRAVEL})\n\
-         {:>5} {:>9} {:>5} {:>6} {:>7} {:>4} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
-        "n", "unknowns", "steps", "newton", "factors", "fthr", "gmres", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
+        "stamp bench: {title}\n\
+         {:>5} {:>9} {:>5} {:>4} {:>6} {:>5} {:>7} {:>4} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
+        "n", "unknowns", "steps", "cuts", "newton", "/step", "factors", "fthr", "gmres", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
     )
 }
 
@@ -219,11 +287,13 @@ pub fn header() -> String {
 pub fn row(r: &BenchRun) -> String {
     let s = &r.seconds;
     format!(
-        "{:>5} {:>9} {:>5} {:>6} {:>7} {:>4} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
+        "{:>5} {:>9} {:>5} {:>4} {:>6} {:>5.1} {:>7} {:>4} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
         r.n,
         r.unknowns,
         r.steps,
+        r.cutbacks,
         r.newton_iterations,
+        r.newton_iterations as f64 / r.steps.max(1) as f64,
         r.factorizations,
         r.factorization_threads,
         r.linear_solver.gmres_iterations,
@@ -247,9 +317,9 @@ pub fn bench_command(sizes: &[usize], json: bool, options: SolverOptions) -> Res
         let text = serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).map_err(|e| StampError::Problem(e.to_string()))?;
         println!("{text}");
     } else {
-        println!("{}", header());
+        println!("{}", header(options.problem));
         run_sizes(sizes, options, |r| println!("{}", row(r)))?;
-        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), fthr: their threads (the first two measure faer's parallel setting against one thread; the faster is kept), gmres: GMRES iterations", rayon::current_num_threads());
+        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; cuts: load increments cut back, newton: iterations of the converged steps (/step: per step), factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), fthr: their threads (the first two measure faer's parallel setting against one thread; the faster is kept), gmres: GMRES iterations", rayon::current_num_threads());
     }
     Ok(())
 }

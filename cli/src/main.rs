@@ -47,9 +47,10 @@ enum Command {
     },
     /// Time the solve of the simply supported plate under a sphere (quarter model) on n x n meshes.
     Bench {
-        /// Mesh sizes n (n x n elements on the quarter), comma separated.
-        #[arg(long, value_delimiter = ',', default_values_t = stamp_cli::bench::DEFAULT_SIZES)]
-        sizes: Vec<usize>,
+        /// Mesh sizes n (n x n elements on the quarter), comma separated (default 25,50,100,200,400;
+        /// with --problem sphere-displacement 10,20,40,80,160).
+        #[arg(long, value_delimiter = ',')]
+        sizes: Option<Vec<usize>>,
         /// Print the results as JSON: {"runs": [...]}.
         #[arg(long)]
         json: bool,
@@ -62,6 +63,10 @@ enum Command {
         /// the GMRES iterations): for comparison.
         #[arg(long)]
         symmetric_part: bool,
+        /// The problem: `sphere` (the default: R = 50 moved down 2 onto the plate of side 100) or
+        /// `sphere-displacement` (meshes/sphere-ss-displacement.toml on n x n meshes).
+        #[arg(long, value_enum, default_value = "sphere")]
+        problem: stamp_cli::bench::BenchProblem,
         /// Run one size in this process and print its JSON (used by `stamp bench` for each size).
         #[arg(long, hide = true)]
         one: Option<usize>,
@@ -76,9 +81,10 @@ fn main() -> ExitCode {
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
         Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
         Some(Command::Check { problem }) => stamp_cli::run::check_command(&problem),
-        Some(Command::Bench { one: Some(n), reuse, symmetric_part, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part }),
-        Some(Command::Bench { sizes, json, reuse, symmetric_part, one: None }) => {
-            stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part })
+        Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem }),
+        Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, one: None }) => {
+            let sizes = sizes.unwrap_or_else(|| problem.default_sizes().to_vec());
+            stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem })
         }
     };
     match result {

@@ -80,3 +80,34 @@ fn bench_with_reuse_gives_the_same_answer_with_fewer_factorisations() {
         assert!((f(&plain, k) / f(&reuse, k) - 1.0).abs() < 1e-8, "{k}: {plain}\n{reuse}");
     }
 }
+
+#[test]
+fn bench_runs_the_displacement_driven_problem_file_on_n_by_n_meshes() {
+    let out = stamp().args(["bench", "--problem", "sphere-displacement", "--sizes", "4,6", "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let runs = v["runs"].as_array().expect("runs");
+    assert_eq!(runs.len(), 2);
+    for (r, n) in runs.iter().zip([4u64, 6]) {
+        assert_eq!(r["n"].as_u64(), Some(n));
+        // meshes/sphere-ss-displacement.toml on an n x n mesh: the same dofs as the default bench
+        let n = n as usize;
+        assert_eq!(r["unknowns"].as_u64(), Some((6 * (n + 1) * (n + 1) - (8 * (n + 1) - 2)) as u64), "{r}");
+        // its 5 equal targets, each a converged step (cut-backs would add steps)
+        let (steps, cutbacks) = (r["steps"].as_u64().unwrap(), r["cutbacks"].as_u64().unwrap());
+        assert_eq!(steps, 5 + cutbacks, "{r}");
+        assert!(r["newton_iterations"].as_u64().unwrap() >= steps, "{r}");
+        // the sphere moves down 0.9 and the augmented Lagrangian holds the penetration below 1e-6:
+        // the top face at the centre is at -0.9 (the mid-surface a little less: the thickness shrinks)
+        let w = r["centre_deflection"].as_f64().unwrap();
+        assert!(w < -0.89 && w > -0.9, "centre deflection {w}");
+        assert!(r["reaction"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    // the table names the problem and has the per-step and cut-back columns
+    let out = stamp().args(["bench", "--problem", "sphere-displacement", "--sizes", "4"]).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("sphere-ss-displacement.toml") && text.contains("cuts") && text.contains("/step"), "{text}");
+    let out = stamp().args(["bench", "--problem", "cube"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("sphere-displacement"), "{}", String::from_utf8_lossy(&out.stderr));
+}

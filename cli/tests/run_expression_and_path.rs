@@ -59,7 +59,14 @@ fn the_sphere_written_as_an_expression_gives_the_built_in_spheres_answers() {
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         assert!(*x > 0.0 && (x - y).abs() <= 1e-8 * x.abs(), "step {}: force {x} (sphere) against {y} (expression)", k + 1);
     }
-    assert_eq!(newton_per_step(&built_in), newton_per_step(&expr), "the same Newton iterations at every step");
+    // The same path up to round-off: Psi is summed in another order, so the last iterate of a
+    // step may land on either side of the round-off criterion "|R| no longer halves" and take one
+    // chord step more (measured: step 4 at |R| 7.3e-7 after 1.46e-6, 4 against 5 iterations).
+    let (na, nb) = (newton_per_step(&built_in), newton_per_step(&expr));
+    assert_eq!(na.len(), nb.len());
+    for (k, (x, y)) in na.iter().zip(&nb).enumerate() {
+        assert!(x.abs_diff(*y) <= 1, "step {}: {x} Newton iterations (sphere) against {y} (expression)", k + 1);
+    }
     assert!(summary(&expr)["punches"][0]["surface"].as_str().unwrap().starts_with("expression psi = (x1)^2"));
 }
 
