@@ -211,6 +211,8 @@ impl NewtonSettings {
 pub struct StepReport {
     pub step: usize,
     pub load_factor: f64,
+    /// Newton iterations of the step, those of the re-solves the problem asked for
+    /// ([`NonlinearProblem::end_step`]: augmented-Lagrangian updates) included.
     pub iterations: usize,
     /// Residual norm at every iteration of the final (converged) attempt, the last one converged.
     pub residual_history: Vec<f64>,
@@ -484,6 +486,8 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 p.apply_prescribed(&mut trial, step_t);
                 p.start_step();
                 let mut restarts = 0;
+                // iterations of the re-solves of this step before the last one
+                let mut restart_iterations = 0;
                 let result = loop {
                     match self.iterate(p, &mut trial, step_t, &mut peak_energy, &mut last_tol) {
                         Ok(h) => {
@@ -494,6 +498,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                                 if restarts < self.settings.max_restarts {
                                     restarts += 1;
                                     summary.newton_iterations += h.len() - 1;
+                                    restart_iterations += h.len() - 1;
                                     continue;
                                 }
                                 let r = h.last().copied().unwrap_or(f64::NAN);
@@ -510,6 +515,8 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 };
                 match result {
                     Ok(history) => {
+                        // the last solve's iterations decide the growth of the increment (as before
+                        // re-solves were counted), the report counts them all
                         let iterations = history.len() - 1;
                         summary.newton_iterations += iterations;
                         summary.steps += 1;
@@ -527,7 +534,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         let report = StepReport {
                             step: summary.steps,
                             load_factor: t,
-                            iterations,
+                            iterations: restart_iterations + iterations,
                             residual_history: history,
                             cutbacks: cutbacks_in_row,
                             is_target,
@@ -587,11 +594,15 @@ mod tests {
         /// end_step asks for another solve every time.
         never_satisfied: bool,
         restarts: usize,
+        /// end_step asks for this many re-solves in all, shifting the solution by 0.01 each time
+        /// (as an augmented-Lagrangian update moves the contact forces).
+        extra_solves: usize,
+        shift: f64,
     }
 
     impl Line {
         fn new() -> Self {
-            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0 }
+            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0, extra_solves: 0, shift: 0.0 }
         }
     }
 
@@ -604,7 +615,7 @@ mod tests {
         }
         fn apply_prescribed(&self, _u: &mut [f64], _t: f64) {}
         fn evaluate(&mut self, u: &[f64], t: f64, _with_tangent: bool) -> Result<Evaluation> {
-            self.residual[0] = if t > self.nan_above { f64::NAN } else { u[0] - t };
+            self.residual[0] = if t > self.nan_above { f64::NAN } else { u[0] - t - self.shift };
             Ok(Evaluation { residual_norm: self.residual[0].abs(), force_scale: 1.0, active_changes: 0 })
         }
         fn residual(&self) -> &[f64] {
@@ -618,6 +629,10 @@ mod tests {
         }
         fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
             self.restarts += 1;
+            if self.restarts <= self.extra_solves {
+                self.shift += 0.01;
+                return true;
+            }
             self.never_satisfied
         }
     }
@@ -674,6 +689,21 @@ mod tests {
         assert!(msg.contains("still violated") && msg.contains("after 3 augmented-Lagrangian updates"), "{msg}");
         // two attempts (one cut-back), each with 1 + 3 solves asking end_step
         assert_eq!(p.restarts, 8);
+    }
+
+    #[test]
+    fn a_step_reports_the_iterations_of_its_re_solves_too() {
+        let mut p = Line { extra_solves: 2, ..Line::new() };
+        let mut u = [0.0];
+        let mut reports = Vec::new();
+        let summary = NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |r, _, _| reports.push(r.clone())).unwrap();
+        assert_eq!(reports.len(), 1);
+        let r = &reports[0];
+        // each of the three solves (the first and two re-solves) takes a Newton iteration
+        assert!(r.iterations >= 3, "{r:?}");
+        assert!(r.iterations > r.residual_history.len() - 1, "the last solve's history only: {r:?}");
+        assert_eq!(r.iterations, summary.newton_iterations);
+        assert!((u[0] - 0.27).abs() < 1e-12, "{}", u[0]);
     }
 
     #[test]
