@@ -423,6 +423,9 @@ pub struct PlateSpec {
     /// v1- = v1+ = 0 at every node.
     #[serde(default)]
     pub plane_strain: bool,
+    /// Transverse shear factor k in (0, 1] (S_a3 = k G 2E_a3); default 1, the paper's.
+    #[serde(default)]
+    pub shear_factor: Option<Positive>,
 }
 
 #[derive(Debug, Deserialize)]
