@@ -82,8 +82,26 @@ pub struct Section {
     /// default and the paper's; 5/6 is Reissner's value for a parabolic shear stress).
     #[serde(default = "unit_shear_factor")]
     pub shear_factor: f64,
+    /// How the transverse normal stress S_33 enters the in-plane law (default: not at all, the
+    /// paper's b_ab33 = 0).
+    #[serde(default)]
+    pub normal_stress: NormalStress,
 }
 
+/// How the transverse normal stress S_33 enters the in-plane stresses S_ab.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NormalStress {
+    /// S_ab by the plane-stress constants alone (b_ab33 = 0, SPEC section 2): the paper's.
+    #[default]
+    Dropped,
+    /// S_ab = plane-stress law + nu / (1 - nu) S33m delta_ab, S33m = T33 / h the mean transverse
+    /// normal stress of the section: the 3D law with S_33 eliminated, for the part of S_33 that is
+    /// constant through the thickness. Zero in pure bending and in a membrane state without face
+    /// loads (T33 = 0 there), so it brings back no Poisson locking; it acts under face loads
+    /// (contact pressure).
+    Mean,
+}
 fn unit_shear_factor() -> f64 {
     1.0
 }
@@ -101,6 +119,7 @@ impl Section {
             delta_plus,
             layers: vec![Layer { bottom: delta_minus, top: delta_plus, material }],
             shear_factor: 1.0,
+            normal_stress: NormalStress::Dropped,
         };
         s.validate()?;
         Ok(s)
@@ -199,6 +218,23 @@ impl Section {
                 d[idx::E33][idx::E22[p]] += lam * int_n[p];
             }
             d[idx::E33][idx::E33] += (lam + 2.0 * g) * (b - a);
+        }
+        if self.normal_stress == NormalStress::Mean {
+            // T+-_ab += int_layer nu/(1-nu) N+- dx3 * (T33 / h) delta_ab, T33 the full row
+            let t33 = d[idx::E33];
+            for l in &self.layers {
+                let c = l.material.poisson / (1.0 - l.material.poisson);
+                let (a, b) = (l.bottom, l.top);
+                // exact integrals of N- and N+ over the layer
+                let i_m = (b - a) * (dp - 0.5 * (a + b)) / h;
+                let i_p = (b - a) * (0.5 * (a + b) - dm) / h;
+                for (p, w) in [i_m, i_p].into_iter().enumerate() {
+                    for col in 0..NSTRAIN {
+                        d[idx::E11[p]][col] += c * w / h * t33[col];
+                        d[idx::E22[p]][col] += c * w / h * t33[col];
+                    }
+                }
+            }
         }
         d
     }

@@ -148,6 +148,7 @@ pub fn build(p: &Problem) -> Result<Setup> {
         None => (ps.delta_minus.unwrap().0, ps.delta_plus.unwrap().0),
     };
     let mut section = Section::homogeneous_offset(dm, dp, material).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
+    section.normal_stress = ps.normal_stress;
     if let Some(k) = ps.shear_factor {
         section = section.with_shear_factor(k.0).map_err(|e| p.error_at(s.plate.span(), "plate.shear_factor", e))?;
     }
