@@ -11,7 +11,8 @@ For each mesh it runs the code, measures the wall time of the whole run (5 load 
 of 0.9) and reads the punch force on the quarter plate at travel 0.9 (stamp: history.csv;
 GetFEM: verification/3d/sphere_plate_getfem.py --json, 3D Saint Venant-Kirchhoff, Q2 hexahedra,
 --nz through the thickness). Each sequence is extrapolated to zero mesh size from its three finest
-meshes, F(l) = F0 + C l^p (p fitted; l = 20 / n, the element side). Then it prints per mesh the
+meshes, F(l) = F0 + C l^p (p fitted; l = 20 / n, the element side; p = 2 when the three are not
+monotone). Then it prints per mesh the
 wall time, the force and its error against the extrapolated 3D force and against the code's own
 extrapolated force, and for each code the shortest measured wall time within 0.5 % of (a) its own
 limit, (b) the 3D limit; if no measured mesh gets there, the time is estimated from the fitted
