@@ -128,6 +128,11 @@ fn iteration_counts_and_unreachable_tolerances_are_refused() {
     // physical sizes whose squares would overflow or vanish
     refused("thickness_tiny", &BASE.replace("thickness = 2.0", "thickness = 5e-324"), Some("thickness ="), &["plate.thickness", "from 1e-100 to 1e100", "5e-324"]);
     refused("young_huge", &BASE.replace("E = 2.0e4", "E = 1e300"), Some("E ="), &["plate.E", "1e300"]);
+    // the plate's model choices
+    let plate_key = |k: &str| BASE.replace("E = 2.0e4", &format!("E = 2.0e4\n{k}"));
+    refused("shear_factor_big", &plate_key("shear_factor = 1.5"), Some("[plate]"), &["plate.shear_factor", "(0, 1]", "1.5"]);
+    refused("shear_factor_zero", &plate_key("shear_factor = 0.0"), Some("shear_factor"), &["plate.shear_factor"]);
+    refused("normal_stress_bad", &plate_key("normal_stress = \"full\""), Some("normal_stress"), &["normal_stress", "dropped", "mean"]);
     refused("force_huge", &BASE.replace("force = [0.0, 0.0, 0.05]", "force = [0.0, 0.0, -1e308]"), Some("force ="), &["load[0].force", "-1e308"]);
     // a penetration far below the round-off of a 100-long model
     let text = format!("{BASE}{PUNCH}penetration_tolerance = 1e-300\n");

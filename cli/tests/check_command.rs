@@ -232,3 +232,14 @@ fn punches_that_move_away_or_sit_on_the_other_side_are_warned_about() {
     let o = stamp(&["run", "-q", "--out", temp_dir("touching").to_str().unwrap()], &repo().join("meshes/sphere-ss-displacement.toml"));
     assert!(o.ok && o.stderr.is_empty(), "{}", o.stderr);
 }
+
+/// The plate's model choices beside the paper's are shown on the plate line, the defaults not.
+#[test]
+fn the_plate_line_names_the_model_choices() {
+    let path = variant("model-choices", "sphere-ss-displacement.toml", &[("nu = 0.3", "nu = 0.3\nnormal_stress = \"mean\"\nshear_factor = 0.8")]);
+    let o = check(&path);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stdout.contains("nu = 0.3, nonlinear, mean S33 in the in-plane law, shear factor 0.8\n"), "{}", o.stdout);
+    let o = check(&repo().join("meshes/sphere-ss-displacement.toml"));
+    assert!(o.stdout.contains("nu = 0.3, nonlinear\n"), "{}", o.stdout);
+}

@@ -13,5 +13,5 @@ pub mod plate;
 pub mod strain;
 
 pub use follower::{fixed_couple_force, FollowerCouple, FollowerPressure};
-pub use material::{Isotropic, Layer, Section};
+pub use material::{Isotropic, Layer, NormalStress, Section};
 pub use plate::{Face, Kinematics, PlateElements, DOFS_PER_NODE};

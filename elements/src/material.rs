@@ -78,6 +78,32 @@ pub struct Section {
     pub delta_minus: f64,
     pub delta_plus: f64,
     pub layers: Vec<Layer>,
+    /// Transverse shear factor k in S_a3 = k G 2E_a3 (SPEC section 2: k = 1, no correction, the
+    /// default and the paper's; 5/6 is Reissner's value for a parabolic shear stress).
+    #[serde(default = "unit_shear_factor")]
+    pub shear_factor: f64,
+    /// How the transverse normal stress S_33 enters the in-plane law (default: not at all, the
+    /// paper's b_ab33 = 0).
+    #[serde(default)]
+    pub normal_stress: NormalStress,
+}
+
+/// How the transverse normal stress S_33 enters the in-plane stresses S_ab.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NormalStress {
+    /// S_ab by the plane-stress constants alone (b_ab33 = 0, SPEC section 2): the paper's.
+    #[default]
+    Dropped,
+    /// S_ab = plane-stress law + nu / (1 - nu) S33m delta_ab, S33m = T33 / h the mean transverse
+    /// normal stress of the section: the 3D law with S_33 eliminated, for the part of S_33 that is
+    /// constant through the thickness. Zero in pure bending and in a membrane state without face
+    /// loads (T33 = 0 there), so it brings back no Poisson locking; it acts under face loads
+    /// (contact pressure).
+    Mean,
+}
+fn unit_shear_factor() -> f64 {
+    1.0
 }
 
 impl Section {
@@ -88,9 +114,22 @@ impl Section {
 
     /// A homogeneous plate between the face planes x3 = delta_minus and x3 = delta_plus.
     pub fn homogeneous_offset(delta_minus: f64, delta_plus: f64, material: Isotropic) -> Result<Self> {
-        let s = Section { delta_minus, delta_plus, layers: vec![Layer { bottom: delta_minus, top: delta_plus, material }] };
+        let s = Section {
+            delta_minus,
+            delta_plus,
+            layers: vec![Layer { bottom: delta_minus, top: delta_plus, material }],
+            shear_factor: 1.0,
+            normal_stress: NormalStress::Dropped,
+        };
         s.validate()?;
         Ok(s)
+    }
+
+    /// The same section with the transverse shear factor k (S_a3 = k G 2E_a3); k must lie in (0, 1].
+    pub fn with_shear_factor(mut self, k: f64) -> Result<Self> {
+        self.shear_factor = k;
+        self.validate()?;
+        Ok(self)
     }
 
     /// Thickness h = delta+ - delta-.
@@ -105,6 +144,12 @@ impl Section {
             return Err(StampError::Material(format!(
                 "the thickness must be positive: delta- = {}, delta+ = {} give h = {h}",
                 self.delta_minus, self.delta_plus
+            )));
+        }
+        if !(self.shear_factor > 0.0 && self.shear_factor <= 1.0) {
+            return Err(StampError::Material(format!(
+                "the transverse shear factor must lie in (0, 1], got {}",
+                self.shear_factor
             )));
         }
         if self.layers.is_empty() {
@@ -127,7 +172,8 @@ impl Section {
         Ok(())
     }
 
-    /// The plate stiffness D (row-major 11 x 11), eq. 2.6 with b_ab33 = 0.
+    /// The plate stiffness D (row-major 11 x 11), eq. 2.6 with b_ab33 = 0, the transverse shear
+    /// scaled by `shear_factor`.
     pub fn stiffness(&self) -> [[f64; NSTRAIN]; NSTRAIN] {
         let h = self.thickness();
         let (dm, dp) = (self.delta_minus, self.delta_plus);
@@ -160,9 +206,9 @@ impl Section {
                     d[idx::E22[p]][idx::E11[q]] += q12 * w;
                     d[idx::E22[p]][idx::E22[q]] += q11 * w;
                     d[idx::E12[p]][idx::E12[q]] += g * w;
-                    // transverse shear, S_a3 = G 2E_a3
-                    d[idx::E13[p]][idx::E13[q]] += g * w;
-                    d[idx::E23[p]][idx::E23[q]] += g * w;
+                    // transverse shear, S_a3 = k G 2E_a3 (k = 1 unless chosen)
+                    d[idx::E13[p]][idx::E13[q]] += self.shear_factor * g * w;
+                    d[idx::E23[p]][idx::E23[q]] += self.shear_factor * g * w;
                 }
             }
             // transverse normal: T33 = lambda int(eps11 + eps22) + (lambda + 2G) h E33 (b_33ab != 0)
@@ -172,6 +218,23 @@ impl Section {
                 d[idx::E33][idx::E22[p]] += lam * int_n[p];
             }
             d[idx::E33][idx::E33] += (lam + 2.0 * g) * (b - a);
+        }
+        if self.normal_stress == NormalStress::Mean {
+            // T+-_ab += int_layer nu/(1-nu) N+- dx3 * (T33 / h) delta_ab, T33 the full row
+            let t33 = d[idx::E33];
+            for l in &self.layers {
+                let c = l.material.poisson / (1.0 - l.material.poisson);
+                let (a, b) = (l.bottom, l.top);
+                // exact integrals of N- and N+ over the layer
+                let i_m = (b - a) * (dp - 0.5 * (a + b)) / h;
+                let i_p = (b - a) * (0.5 * (a + b) - dm) / h;
+                for (p, w) in [i_m, i_p].into_iter().enumerate() {
+                    for col in 0..NSTRAIN {
+                        d[idx::E11[p]][col] += c * w / h * t33[col];
+                        d[idx::E22[p]][col] += c * w / h * t33[col];
+                    }
+                }
+            }
         }
         d
     }

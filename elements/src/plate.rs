@@ -10,7 +10,7 @@
 //! ([`Element::has_preconditioner`]).
 
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
-use crate::material::{Section, NSTRAIN};
+use crate::material::{NormalStress, Section, NSTRAIN};
 use crate::strain::{Affine, Sample, NDOF, NPAIR};
 use stamp::element::{Element, LocalSystem};
 use stamp::linalg::vector_state::clean_upper_vector_state;
@@ -151,7 +151,10 @@ impl PlateElements {
         mesh.validate()?;
         let geometry = (0..mesh.num_cells()).map(|c| ElementGeometry::new(&mesh.cell_coords(c), c)).collect::<Result<Vec<_>>>()?;
         let d = section.stiffness();
-        let coupled = (0..NSTRAIN).any(|c| c != E33_ROW && d[E33_ROW][c] != 0.0);
+        // the split preconditioner needs D0 (D without the row of T33's coupling) symmetric: not so
+        // when S_33 enters the in-plane law, which then leaves the preconditioner to the solver
+        let coupled = section.normal_stress == NormalStress::Dropped
+            && (0..NSTRAIN).any(|c| c != E33_ROW && d[E33_ROW][c] != 0.0);
         let mut d_rows = [([(0, 0.0); NSTRAIN], 0); NSTRAIN];
         for (r, (entries, n)) in d_rows.iter_mut().enumerate() {
             for c in (0..NSTRAIN).filter(|&c| d[r][c] != 0.0) {

@@ -154,7 +154,11 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         Some(h) => (-0.5 * h.0, 0.5 * h.0),
         None => (ps.delta_minus.unwrap().0, ps.delta_plus.unwrap().0),
     };
-    let section = Section::homogeneous_offset(dm, dp, material).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
+    let mut section = Section::homogeneous_offset(dm, dp, material).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
+    section.normal_stress = ps.normal_stress;
+    if let Some(k) = ps.shear_factor {
+        section = section.with_shear_factor(k.0).map_err(|e| p.error_at(s.plate.span(), "plate.shear_factor", e))?;
+    }
     let kin = match ps.kinematics {
         KinematicsSpec::Nonlinear => Kinematics::Nonlinear,
         KinematicsSpec::Linear => Kinematics::Linear,

@@ -408,14 +408,16 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
     let ps = s.plate.get_ref();
     let _ = writeln!(
         o,
-        "plate: thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}",
+        "plate: thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}{}{}",
         num(setup.section.thickness()),
         num(setup.section.delta_minus),
         num(setup.section.delta_plus),
         num(ps.young.0),
         num(ps.nu.0),
         format!("{:?}", ps.kinematics).to_lowercase(),
-        if ps.plane_strain { ", plane strain" } else { "" }
+        if ps.plane_strain { ", plane strain" } else { "" },
+        if setup.section.normal_stress == stamp_elements::NormalStress::Mean { ", mean S33 in the in-plane law" } else { "" },
+        if setup.section.shear_factor != 1.0 { format!(", shear factor {}", num(setup.section.shear_factor)) } else { String::new() }
     );
     let nodal = setup.model.dofs.num_equations();
     let drives = setup.model.num_drives();

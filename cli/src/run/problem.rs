@@ -423,6 +423,12 @@ pub struct PlateSpec {
     /// v1- = v1+ = 0 at every node.
     #[serde(default)]
     pub plane_strain: bool,
+    /// Transverse shear factor k in (0, 1] (S_a3 = k G 2E_a3); default 1, the paper's.
+    #[serde(default)]
+    pub shear_factor: Option<Positive>,
+    /// How S_33 enters the in-plane law: "dropped" (default, b_ab33 = 0) or "mean".
+    #[serde(default)]
+    pub normal_stress: stamp_elements::NormalStress,
 }
 
 #[derive(Debug, Deserialize)]
