@@ -109,27 +109,8 @@ impl RunFolder {
     /// Create `dir` if needed, remove the previous run's files and mark the folder as in use.
     pub fn claim(dir: &Path) -> Result<RunFolder> {
         std::fs::create_dir_all(dir).map_err(|e| StampError::io(dir, e))?;
-        let manifest_path = dir.join(MANIFEST);
-        let previous: Vec<String> = match std::fs::read_to_string(&manifest_path) {
-            Ok(text) => match serde_json::from_str::<Manifest>(&text) {
-                Ok(m) if m.status == "complete" => m.written,
-                Ok(m) => {
-                    // killed mid-run: stamp-named files that were not there before it
-                    let now = listing(dir)?;
-                    now.keys().filter_map(|k| k.to_str()).filter(|k| !m.before.iter().any(|b| b == k) && looks_like_output(k)).map(|k| k.to_string()).collect()
-                }
-                Err(_) => Vec::new(),
-            },
-            Err(_) => legacy_outputs(dir),
-        };
-        let mut removed = Vec::new();
-        for name in previous.iter().filter(|n| plain_name(n)) {
-            let path = dir.join(name);
-            if std::fs::symlink_metadata(&path).map(|m| m.is_file()).unwrap_or(false) {
-                std::fs::remove_file(&path).map_err(|e| StampError::io(&path, e))?;
-                removed.push(name.clone());
-            }
-        }
+        let mut removed = remove_previous_outputs(dir, true)?;
+        removed.extend(remove_refined_runs(dir)?);
         let before = listing(dir)?;
         let manifest = Manifest { status: "running".into(), written: Vec::new(), before: before.keys().filter_map(|k| k.to_str().map(String::from)).collect() };
         write_manifest(dir, &manifest)?;
@@ -154,6 +135,57 @@ impl RunFolder {
         let written = self.written()?;
         write_manifest(&self.dir, &Manifest { status: "complete".into(), written, before: Vec::new() })
     }
+}
+
+/// Removes the files the previous run wrote in `dir` (see the module notes; `legacy`: also a
+/// folder written before manifests existed) and returns their names.
+fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {
+    let previous: Vec<String> = match std::fs::read_to_string(dir.join(MANIFEST)) {
+        Ok(text) => match serde_json::from_str::<Manifest>(&text) {
+            Ok(m) if m.status == "complete" => m.written,
+            Ok(m) => {
+                // killed mid-run: stamp-named files that were not there before it
+                let now = listing(dir)?;
+                now.keys().filter_map(|k| k.to_str()).filter(|k| !m.before.iter().any(|b| b == k) && looks_like_output(k)).map(|k| k.to_string()).collect()
+            }
+            Err(_) => Vec::new(),
+        },
+        Err(_) if legacy => legacy_outputs(dir),
+        Err(_) => Vec::new(),
+    };
+    let mut removed = Vec::new();
+    for name in previous.iter().filter(|n| plain_name(n)) {
+        let path = dir.join(name);
+        if std::fs::symlink_metadata(&path).map(|m| m.is_file()).unwrap_or(false) {
+            std::fs::remove_file(&path).map_err(|e| StampError::io(&path, e))?;
+            removed.push(name.clone());
+        }
+    }
+    Ok(removed)
+}
+
+/// Removes the finer runs a `stamp run --refine` left in `dir` (`refined/`, `refined2/`, ...:
+/// sub-folders with a manifest): their files, their manifest, and the folder when nothing else is
+/// in it. A later run without `--refine` (or with fewer levels) would otherwise leave results of
+/// another run beside its own. Returns the removed files as `refined/name`.
+fn remove_refined_runs(dir: &Path) -> Result<Vec<String>> {
+    let mut removed = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(|e| StampError::io(dir, e))? {
+        let entry = entry.map_err(|e| StampError::io(dir, e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let is_refined_name = name.strip_prefix("refined").is_some_and(|rest| rest.chars().all(|c| c.is_ascii_digit()));
+        let sub = entry.path();
+        // a real folder (not a link) that a run claimed
+        let is_dir = std::fs::symlink_metadata(&sub).map(|m| m.is_dir()).unwrap_or(false);
+        if !is_refined_name || !is_dir || !sub.join(MANIFEST).is_file() {
+            continue;
+        }
+        removed.extend(remove_previous_outputs(&sub, false)?.into_iter().map(|f| format!("{name}/{f}")));
+        std::fs::remove_file(sub.join(MANIFEST)).map_err(|e| StampError::io(&sub.join(MANIFEST), e))?;
+        // only if empty: files the user put there stay, and so does the folder
+        let _ = std::fs::remove_dir(&sub);
+    }
+    Ok(removed)
 }
 
 impl Drop for RunFolder {
@@ -205,6 +237,31 @@ mod tests {
             std::fs::write(d.join("a_0001.vtu"), "y").unwrap();
         }
         assert_eq!(names(&d), [".stamp-run", "a_0001.vtu", "b_0009.vtu", "notes.txt"]);
+    }
+
+    #[test]
+    fn a_run_removes_the_finer_runs_of_a_previous_refine() {
+        let d = dir("refined");
+        // a --refine 2 run: the top folder and two finer runs, each claimed
+        {
+            let _top = RunFolder::claim(&d).unwrap();
+            std::fs::write(d.join("summary.json"), "{}").unwrap();
+            for sub in ["refined", "refined2"] {
+                let f = RunFolder::claim(&d.join(sub)).unwrap();
+                std::fs::write(d.join(sub).join("summary.json"), "{}").unwrap();
+                std::fs::write(d.join(sub).join("p_0001.vtu"), "x").unwrap();
+                f.finish().unwrap();
+            }
+        }
+        // the user's own notes in one of them, and a folder of theirs named alike without a manifest
+        std::fs::write(d.join("refined2").join("notes.txt"), "mine").unwrap();
+        std::fs::create_dir_all(d.join("refined3")).unwrap();
+        std::fs::write(d.join("refined3").join("p_0001.vtu"), "mine").unwrap();
+        let f = RunFolder::claim(&d).unwrap();
+        assert!(!d.join("refined").exists(), "refined/ left: {:?}", names(&d));
+        assert_eq!(names(&d.join("refined2")), vec!["notes.txt"]);
+        assert_eq!(names(&d.join("refined3")), vec!["p_0001.vtu"]);
+        assert!(f.removed.contains(&"refined/p_0001.vtu".to_string()) && f.removed.contains(&"refined2/summary.json".to_string()), "{:?}", f.removed);
     }
 
     #[test]
