@@ -51,6 +51,26 @@ pub fn plate(mesh: &QuadMesh, h: f64, kin: Kinematics) -> PlateElements {
     PlateElements::new(mesh, steel_section(h), kin).unwrap()
 }
 
+/// The largest difference between the element's tangent at `v` and central finite differences
+/// (step 1e-6) of its internal force, relative to the largest tangent entry.
+pub fn tangent_fd_error(plate: &PlateElements, v: &[f64]) -> f64 {
+    let n = v.len();
+    let k = eval(plate, v, true).tangent;
+    let scale = max_abs(&k);
+    let step = 1e-6;
+    let mut worst: f64 = 0.0;
+    for j in 0..n {
+        let (mut vp, mut vm) = (v.to_vec(), v.to_vec());
+        vp[j] += step;
+        vm[j] -= step;
+        let (rp, rm) = (eval(plate, &vp, false).residual, eval(plate, &vm, false).residual);
+        for i in 0..n {
+            worst = worst.max(((rp[i] - rm[i]) / (2.0 * step) - k[i * n + j]).abs() / scale);
+        }
+    }
+    worst
+}
+
 pub fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
