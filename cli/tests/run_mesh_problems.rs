@@ -408,3 +408,21 @@ fn a_force_driven_punch_may_start_off_the_plate() {
     }
     assert!(compared >= 2 && f(&steps(&gap).last().unwrap()["load_factor"]) == 1.0, "{compared} common load factors");
 }
+
+#[test]
+fn ellipsoid_written_as_an_expression() {
+    // meshes/ellipsoid-expression.toml: semi-axes 120 (x1), 80 (x2), 40 (x3), pressed with 4000 onto
+    // a clamped plate, whole model
+    let (s, _) = run_mesh("ellipsoid-expression");
+    check_common("ellipsoid-expression", &s);
+    let st = steps(&s);
+    let d: Vec<f64> = st.iter().map(|e| f(&e["punches"]["ellipsoid"]["drive_displacement"])).collect();
+    assert!(d.windows(2).all(|w| w[1] > w[0]) && d[0] > 0.0, "travel {d:?}");
+    // curvature radii at the tip: 120^2 / 40 = 360 along x1, 80^2 / 40 = 160 along x2: the loaded
+    // zone is longer along x1, and symmetric about both axes
+    let zone = &st.last().unwrap()["loaded_zone"];
+    let (lo, hi) = (&zone["min"], &zone["max"]);
+    let (lx, ly) = (f(&hi[0]) - f(&lo[0]), f(&hi[1]) - f(&lo[1]));
+    assert!(lx > 1.2 * ly && ly > 0.0, "loaded zone {zone}");
+    assert!((f(&hi[0]) + f(&lo[0])).abs() < 1e-9 && (f(&hi[1]) + f(&lo[1])).abs() < 1e-9, "loaded zone {zone}");
+}
