@@ -257,14 +257,33 @@ pub struct ContactPair {
     /// leaves the plate free around it, so it penetrates the punch far beyond the contact zone
     /// of the solution; taking all of that band in overshoots, and an overshooting set comes
     /// back one ring of nodes per iteration (only its outermost ring turns tensile, the
-    /// multipliers inside a conforming zone being close to zero).
+    /// multipliers inside a conforming zone being close to zero). From an empty set (the first
+    /// evaluation, or every point released) the fraction is [`FIRST_TOUCH_FRACTION`], at the
+    /// first evaluation with a tangent of a load step [`STEP_START_ENTRY_FRACTION`].
     pub entry_fraction: f64,
+    /// The entry fraction from an empty active set (default [`FIRST_TOUCH_FRACTION`]); None:
+    /// every penetrating point enters at the first evaluation, `entry_fraction` after a release.
+    pub first_touch_fraction: Option<f64>,
+    /// The entry fraction at the first evaluation with a tangent of a load step (default
+    /// [`STEP_START_ENTRY_FRACTION`]); None: `entry_fraction`.
+    pub step_start_entry_fraction: Option<f64>,
+    /// No evaluation with a tangent yet in this load step.
+    step_start: bool,
     /// The point kinematics of the last evaluation (scratch, reused).
     kinematics_scratch: Vec<(f64, Vector3<f64>, f64, Option<Vector3<f64>>)>,
 }
 
 /// The default [`ContactPair::entry_fraction`].
 pub const ENTRY_FRACTION: f64 = 0.5;
+
+/// The entry fraction when the active set is empty (the first evaluation, or every point
+/// released): only the deepest penetrations enter (a body first touches a punch at a point).
+pub const FIRST_TOUCH_FRACTION: f64 = 0.7;
+
+/// The entry fraction at the first evaluation with a tangent of a load step (after the
+/// predictor, which overshoots: a point that entered contact in the last step is predicted to
+/// penetrate by its previous gap).
+pub const STEP_START_ENTRY_FRACTION: f64 = 0.9;
 
 impl ContactPair {
     pub fn new(name: impl Into<String>, surface: Arc<dyn ContactSurface>, points: Vec<ContactPoint>, eps_reg: f64, kinematics: ContactKinematics) -> Self {
@@ -288,6 +307,9 @@ impl ContactPair {
             lambda_scale: 0.0,
             surface_at_points: vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; n],
             entry_fraction: ENTRY_FRACTION,
+            first_touch_fraction: Some(FIRST_TOUCH_FRACTION),
+            step_start_entry_fraction: Some(STEP_START_ENTRY_FRACTION),
+            step_start: true,
             kinematics_scratch: Vec::new(),
         }
     }
@@ -296,6 +318,7 @@ impl ContactPair {
     pub fn start_step(&mut self) {
         self.flips.fill(0);
         self.frozen.fill(false);
+        self.step_start = true;
         self.lambda_scale = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
     }
 
@@ -394,14 +417,29 @@ impl ContactPair {
         // Damped growth of the active set (see `entry_fraction`): in an evaluation with a tangent,
         // an inactive point enters only where its trial multiplier is at or below entry_fraction
         // times the most negative trial of the inactive points
-        let entry_cut = if with_tangent && !first && !self.hold_active_set && self.entry_fraction > 0.0 {
+        // Contact starting from an empty set (the first evaluation, or every point released)
+        // starts at the deepest points only (FIRST_TOUCH_FRACTION): a body first touches a punch
+        // at a point, and taking the whole overlap in puts every point on the punch's tangent
+        // plane, from where the convex Psi releases them all (the set then ping-pongs and
+        // shrinks ring by ring). The first iteration of a step damps harder
+        // (STEP_START_ENTRY_FRACTION): the predictor's penetrations overshoot.
+        let damped = with_tangent && !self.hold_active_set && self.entry_fraction > 0.0;
+        let first_touch = self.first_touch_fraction.filter(|_| damped);
+        let empty = first || !self.last_active.iter().zip(&self.frozen).any(|(a, f)| *a || *f);
+        let entry_cut = if damped && (!first || first_touch.is_some()) {
             let deepest = kin
                 .iter()
                 .enumerate()
-                .filter(|(k, _)| !self.last_active[*k] && !self.frozen[*k])
+                .filter(|(k, _)| first || (!self.last_active[*k] && !self.frozen[*k]))
                 .map(|(k, q)| self.lambda_bar[k] + self.eps_reg * q.0)
                 .fold(0.0f64, f64::min);
-            self.entry_fraction * deepest
+            if let (true, Some(f)) = (empty, first_touch) {
+                f * deepest
+            } else if let (true, Some(f)) = (self.step_start, self.step_start_entry_fraction) {
+                f * deepest
+            } else {
+                self.entry_fraction * deepest
+            }
         } else {
             0.0
         };
@@ -411,7 +449,7 @@ impl ContactPair {
             // touching points (Psi = 0) belong to the active set
             let wanted = trial <= 0.0;
             if first {
-                self.last_active[k] = wanted;
+                self.last_active[k] = if first_touch.is_some() { false } else { wanted };
             }
             // a penetrating point held back by the entry rule: still a change (the step is not
             // converged), but neither force nor tangent in this evaluation
@@ -500,6 +538,9 @@ impl ContactPair {
         }
         if first {
             self.initialized = true;
+        }
+        if with_tangent {
+            self.step_start = false;
         }
         self.kinematics_scratch = kin;
         changes
@@ -710,21 +751,60 @@ mod entry_tests {
     #[test]
     fn only_the_deepest_half_of_the_new_penetrations_enters() {
         let mut p = pair(0.5);
-        // first evaluation: nothing touches
-        assert_eq!(evaluate(&mut p, [0.0; 4]), (0, vec![false; 4]));
-        // penetrations 1, 0.6, 0.4 and none (x3 = w - 1e-3): the deepest is 0.999, half of it
-        // 0.4995; 0.599 enters, 0.399 is held back but counts as a change
-        let w = [1.0, 0.6, 0.4, 0.0];
+        // first evaluation: the last point touches (Psi = 0), the others are clear
+        assert_eq!(evaluate(&mut p, [0.0, 0.0, 0.0, 1e-3]), (1, vec![false, false, false, true]));
+        // penetrations 1, 0.6, 0.4 (x3 = w - 1e-3): the deepest is 0.999, half of it 0.4995;
+        // 0.599 enters, 0.399 is held back but counts as a change
+        let w = [1.0, 0.6, 0.4, 1e-3];
         let (changes, active) = evaluate(&mut p, w);
-        assert_eq!(active, vec![true, true, false, false]);
+        assert_eq!(active, vec![true, true, false, true]);
         assert_eq!(changes, 3, "two points entered, one is held back");
         // the held-back point gets no force
         assert_eq!(p.state[2].lambda, 0.0);
         assert!(p.state[0].lambda < 0.0 && p.state[1].lambda < 0.0);
         // next time it is the deepest of the inactive points: it enters, and then nothing changes
         let (changes, active) = evaluate(&mut p, w);
-        assert_eq!((changes, active), (1, vec![true, true, true, false]));
+        assert_eq!((changes, active), (1, vec![true, true, true, true]));
         assert_eq!(evaluate(&mut p, w).0, 0);
+    }
+
+    #[test]
+    fn from_an_empty_set_only_the_deepest_penetrations_enter() {
+        // the very first evaluation already overlaps: only the trials within 0.7 of the deepest
+        // (-9.99) enter: -5.99 and -3.99 are held back
+        let mut p = pair(0.5);
+        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]);
+        assert_eq!(active, vec![true, false, false, false]);
+        assert_eq!(changes, 3, "one point entered, two are held back");
+        assert_eq!(p.state[1].lambda, 0.0);
+        // then the set grows by the damped rule (0.599 and 0.399 against half of 0.599: both)
+        assert_eq!(evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]), (2, vec![true, true, true, false]));
+        // every point released, then two equally deep penetrations: both enter, the shallower
+        // (-2.99 against 0.7 * -4.99) is held back
+        let mut p = pair(0.5);
+        assert_eq!(evaluate(&mut p, [0.0; 4]), (0, vec![false; 4]));
+        let (changes, active) = evaluate(&mut p, [0.5, 0.5, 0.3, 0.0]);
+        assert_eq!((changes, active), (3, vec![true, true, false, false]));
+        // a residual-only evaluation (line-search trial) still sees every penetration
+        let mut p = pair(0.5);
+        let mut u = vec![0.0; 12];
+        u[2] = 1.0;
+        u[5] = 0.6;
+        let mut force = vec![0.0; 12];
+        assert_eq!(p.evaluate(&u, 0.0, &mut force, None), 0, "the first evaluation records its set");
+        assert!(force[2] != 0.0 && force[5] != 0.0);
+    }
+
+    #[test]
+    fn the_first_iteration_of_a_load_step_takes_only_the_deepest_tenth() {
+        let mut p = pair(0.5);
+        evaluate(&mut p, [0.0, 0.0, 0.0, 1e-3]);
+        p.start_step();
+        // trials -9.99, -5.99, -3.99 against 0.9 * -9.99: only the first enters
+        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 1e-3]);
+        assert_eq!((changes, active), (3, vec![true, false, false, true]));
+        // the next iteration uses entry_fraction (half of -5.99): both enter
+        assert_eq!(evaluate(&mut p, [1.0, 0.6, 0.4, 1e-3]), (2, vec![true; 4]));
     }
 
     #[test]
