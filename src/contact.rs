@@ -242,11 +242,11 @@ pub struct ContactPair {
     /// The largest |lambda| seen in the current load step (the scale of "near the kink" for
     /// frozen points while every point is momentarily inactive).
     pub lambda_scale: f64,
-    /// Where each point was at the last evaluation (exact kinematics), and Psi and its gradient
-    /// there: computed in parallel before the points are visited in order (a die given by a
-    /// triangle mesh or an expression costs microseconds per point), and not again while the
-    /// point stays where it was (Newton's next iteration starts where the line search's accepted
-    /// trial evaluated).
+    /// Where the surface was last queried for each point, and Psi and its gradient there:
+    /// computed in parallel before the points are visited in order (a die given by a triangle
+    /// mesh or an expression costs microseconds per point), and not again while the point stays
+    /// where it was (Newton's next iteration starts where the line search's accepted trial
+    /// evaluated).
     surface_at_points: Vec<SurfaceAtPoint>,
     /// Damped growth of the active set: in an evaluation with a tangent, a penetrating inactive
     /// point enters the active set only where its trial multiplier lambda_bar + eps Psi is at
@@ -375,45 +375,42 @@ impl ContactPair {
         self.lambda_scale = self.lambda_scale.max(current);
         let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
         let mut any_tangent = false;
-        if let ContactKinematics::Exact = self.kinematics {
-            let surface = &*self.surface;
-            self.surface_at_points.par_iter_mut().zip(self.points.par_iter()).with_min_len(512).for_each(|(out, p)| {
-                // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
-                crate::linalg::vector_state::clean_upper_vector_state();
-                let x = Vector3::from(p.x_ref) + Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]) - d;
-                // (NaN at the start: never equal)
-                if x != out.x {
-                    let grad = surface.gradient(&x);
-                    *out = SurfaceAtPoint { x, psi: surface.psi(&x), grad };
-                }
-            });
-        }
-        // Psi, its gradient with respect to the point's displacement and to s, the Hessian point,
-        // for every point first (the entry rule below needs the deepest penetration)
+        // Psi, its gradient with respect to the point's displacement and to s, and where the
+        // Hessian is taken, for every point first (the entry rule below needs the deepest
+        // penetration), in parallel. The surface is queried at x (exact kinematics) or at the
+        // reference position moved back by the prescribed motion (shallow: linearised about it),
+        // and not again while that point stays where it was.
         let mut kin = std::mem::take(&mut self.kinematics_scratch);
-        kin.clear();
-        for (k, p) in self.points.iter().enumerate() {
+        kin.resize(self.points.len(), (0.0, Vector3::zeros(), 0.0, None));
+        let surface = &*self.surface;
+        let kinematics = self.kinematics;
+        let prescribed = Vector3::from(self.motion.displacement(t));
+        let s = drive.map(|f| u[f.dof]).unwrap_or(0.0);
+        (kin.par_iter_mut(), self.surface_at_points.par_iter_mut(), self.points.par_iter()).into_par_iter().with_min_len(512).for_each(|(out, at, p)| {
+            // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
+            crate::linalg::vector_state::clean_upper_vector_state();
             let x_ref = Vector3::from(p.x_ref);
             let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
-            let point = match self.kinematics {
-                ContactKinematics::Exact => {
-                    let x = x_ref + disp - d;
-                    let SurfaceAtPoint { psi, grad: g, .. } = self.surface_at_points[k];
-                    (psi, g, -g.dot(&dn), Some(x))
-                }
+            let x = match kinematics {
+                ContactKinematics::Exact => x_ref + disp - d,
+                ContactKinematics::Shallow { .. } => x_ref - prescribed,
+            };
+            // (NaN at the start: never equal)
+            if x != at.x {
+                let (psi, grad) = surface.psi_and_gradient(&x);
+                *at = SurfaceAtPoint { x, psi, grad };
+            }
+            let SurfaceAtPoint { psi, grad: g, .. } = *at;
+            *out = match kinematics {
+                ContactKinematics::Exact => (psi, g, -g.dot(&dn), Some(x)),
                 ContactKinematics::Shallow { direction } => {
-                    // linearised about the reference position and the prescribed motion: in the
-                    // plate's displacement along n and in the punch's unknown s
+                    // in the plate's displacement along n and in the punch's unknown s
                     let n = Vector3::from(direction);
-                    let x0 = x_ref - Vector3::from(self.motion.displacement(t));
-                    let g0 = self.surface.gradient(&x0);
-                    let gn = g0.dot(&n);
-                    let s = drive.map(|f| u[f.dof]).unwrap_or(0.0);
-                    (self.surface.psi(&x0) + gn * disp.dot(&n) - g0.dot(&dn) * s, n * gn, -g0.dot(&dn), None)
+                    let gn = g.dot(&n);
+                    (psi + gn * disp.dot(&n) - g.dot(&dn) * s, n * gn, -g.dot(&dn), None)
                 }
             };
-            kin.push(point);
-        }
+        });
         // Damped growth of the active set (see `entry_fraction`): in an evaluation with a tangent,
         // an inactive point enters only where its trial multiplier is at or below entry_fraction
         // times the most negative trial of the inactive points

@@ -19,6 +19,13 @@ pub trait ContactSurface: Send + Sync {
     /// The gradient of Psi at x.
     fn gradient(&self, x: &Vector3<f64>) -> Vector3<f64>;
 
+    /// Psi and its gradient at x together, as the contact constraint asks for them at every
+    /// point. Default: [`psi`](Self::psi) and [`gradient`](Self::gradient); override it when the
+    /// two share their work (an expression's one evaluation, a die's one closest-facet search).
+    fn psi_and_gradient(&self, x: &Vector3<f64>) -> (f64, Vector3<f64>) {
+        (self.psi(x), self.gradient(x))
+    }
+
     /// The Hessian of Psi at x. Default: central differences of [`gradient`](Self::gradient) with a
     /// step of 1e-5 of [`length_scale`](Self::length_scale), symmetrised.
     fn hessian(&self, x: &Vector3<f64>) -> Matrix3<f64> {

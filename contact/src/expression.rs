@@ -122,6 +122,11 @@ impl ContactSurface for Expression {
         Vector3::from(self.jet(x).g)
     }
 
+    fn psi_and_gradient(&self, x: &Vector3<f64>) -> (f64, Vector3<f64>) {
+        let j = self.jet(x);
+        (j.v, Vector3::from(j.g))
+    }
+
     fn hessian(&self, x: &Vector3<f64>) -> Matrix3<f64> {
         let h = self.jet(x).h;
         Matrix3::from_fn(|i, j| h[i][j])
@@ -242,6 +247,8 @@ mod tests {
             assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{a} against {b}");
             assert!((e.gradient(&x) - s.gradient(&x)).norm() <= 1e-12 * s.gradient(&x).norm());
             assert_eq!(e.hessian(&x), s.hessian(&x));
+            // psi and the gradient asked together are those asked one by one
+            assert_eq!(e.psi_and_gradient(&x), (e.psi(&x), e.gradient(&x)));
         }
     }
 

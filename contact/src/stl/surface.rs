@@ -306,13 +306,18 @@ impl StlSurface {
 
 impl ContactSurface for StlSurface {
     fn psi(&self, x: &Vector3<f64>) -> f64 {
-        let q = self.query(x);
-        (x - q.closest.point).dot(&self.normal(&q))
+        self.psi_and_gradient(x).0
     }
 
     fn gradient(&self, x: &Vector3<f64>) -> Vector3<f64> {
         let q = self.query(x);
         self.normal(&q)
+    }
+
+    fn psi_and_gradient(&self, x: &Vector3<f64>) -> (f64, Vector3<f64>) {
+        let q = self.query(x);
+        let n = self.normal(&q);
+        ((x - q.closest.point).dot(&n), n)
     }
 
     fn hessian(&self, x: &Vector3<f64>) -> Matrix3<f64> {
@@ -417,6 +422,8 @@ mod tests {
                 assert!((got - want).abs() <= 1e-12 * want.max(1.0), "point {x:?}, hint {hint:?}: {got} against {want}");
             }
             last = Some(s.search(&x, last).facet);
+            // psi and the gradient asked together are those asked one by one
+            assert_eq!(s.psi_and_gradient(&x), (s.psi(&x), s.gradient(&x)));
         }
     }
 }
