@@ -155,6 +155,18 @@ fn a_punch_starting_inside_the_plate_is_refused() {
     let centre = g.mesh.coords.iter().position(|c| c[0] == 0.0 && c[1] == 0.0).unwrap();
     let o = check(&full);
     assert!(!o.ok && o.stderr.contains(&format!("1 deep at the node at (x1, x2) = (0, 0) (gmsh node {})", g.node_tags[centre])), "{}", o.stderr);
+    // a node the reader added where it cut a triangle has no gmsh tag to name
+    let tri = repo().join("tests/data/quarter/tri.msh");
+    let g = stamp::io::read_msh(&tri).unwrap();
+    let added = g.node_tags.iter().position(|&t| t == 0).expect("tri.msh is cut into quadrilaterals");
+    let [x, y] = [g.mesh.coords[added][0], g.mesh.coords[added][1]];
+    let text = format!(
+        "[mesh]\nfile = {:?}\n[plate]\nthickness = 1.0\nE = 2.1e5\nnu = 0.3\n[[boundary]]\ngroup = \"edge\"\nfix = [\"clamped\"]\n\
+         [[punch]]\nshape = \"sphere\"\ncenter = [{x:?}, {y:?}, 199.5]\nradius = 200.0\nmotion = [0.0, 0.0, -0.1]\n",
+        tri.display().to_string()
+    );
+    let o = check(&write("sunk-added", &[("sunk-added.toml", &text)]));
+    assert!(!o.ok && o.stderr.contains("(not a gmsh node: added where a cell was cut)"), "{}", o.stderr);
 }
 
 /// tests/data/rect.msh (a 2 x 1 plate, 4 x 2 quadrilaterals) without the line elements of the

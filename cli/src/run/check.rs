@@ -91,10 +91,15 @@ fn bbox(mesh: &MeshData) -> ([f64; 2], [f64; 2]) {
     (lo, hi)
 }
 
-/// "node at (x1, x2) = (1, 2) (gmsh node 17)".
+/// "node at (x1, x2) = (1, 2) (gmsh node 17)"; a node the reader or a refinement added (tag 0)
+/// has no gmsh tag to name.
 fn where_node(mesh: &MeshData, node: usize) -> String {
     let x = mesh.mesh.coords[node];
-    let tag = mesh.node_tags.as_ref().and_then(|t| t.get(node)).map(|t| format!(" (gmsh node {t})")).unwrap_or_default();
+    let tag = match mesh.node_tags.as_ref().and_then(|t| t.get(node)) {
+        Some(0) => " (not a gmsh node: added where a cell was cut)".to_string(),
+        Some(t) => format!(" (gmsh node {t})"),
+        None => String::new(),
+    };
     format!("the node at (x1, x2) = ({}, {}){tag}", num(x[0]), num(x[1]))
 }
 
