@@ -202,6 +202,9 @@ fn a_probe_through_nodes_of_the_rectangle_gives_the_nodal_values() {
     for name in ["probe_nodes.png", "probe_fine.svg", "force_travel_sphere.png"] {
         assert!(out.join(name).exists(), "{name}");
     }
+    // the title gives the line's ends to 4 significant digits
+    let svg = std::fs::read_to_string(out.join("probe_fine.svg")).unwrap();
+    assert!(svg.contains("from (0, 0) to (20.00, 0)"), "the probe's title");
 }
 
 #[test]

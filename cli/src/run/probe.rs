@@ -23,7 +23,7 @@
 //! point: the active node of the first written step closest to the pressure-weighted centre of its
 //! active nodes, or, when nothing touches yet, the node closest to the punch.
 
-use super::history::{mid_displacement, History, HistoryRow};
+use super::history::{mid_displacement, sig4, History, HistoryRow};
 use super::mesh::MeshData;
 use super::plot::{write_plot, Plot, Series};
 use super::problem::Problem;
@@ -437,7 +437,8 @@ impl<'a> Probes<'a> {
                     Series { label: history.step_label(&c.row, units), points: c.points.clone(), markers: c.markers.clone() }
                 })
                 .collect();
-            let title = format!("contact pressure along probe '{}' from ({}, {}) to ({}, {})", line.name, line.from[0], line.from[1], line.to[0], line.to[1]);
+            let [a, b] = [line.from, line.to].map(|p| format!("({}, {})", sig4(p[0]), sig4(p[1])));
+            let title = format!("contact pressure along probe '{}' from {a} to {b}", line.name);
             let x = Units::label("distance along the line", &units.length);
             let y = Units::label("contact pressure q_n", &units.pressure);
             let plot = Plot { title: &title, x_label: &x, y_label: &y, series: &series };
