@@ -22,6 +22,7 @@ use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
 use stamp::{Result, StampError};
 use stamp_contact::Sphere;
+use crate::run::plate_model::Plate;
 use stamp_elements::{Face, Isotropic, Kinematics, PlateElements, Section};
 use std::sync::Arc;
 use std::time::Instant;
@@ -113,7 +114,7 @@ pub struct BenchRun {
 }
 
 /// Build the quarter model on an n x n mesh.
-fn build(n: usize) -> Result<Model<PlateElements>> {
+fn build(n: usize) -> Result<Model<Plate>> {
     let half = 0.5 * SIDE;
     let mesh = QuadMesh::rectangle(0.0, half, 0.0, half, n, n)?;
     let section = Section::homogeneous(THICKNESS, Isotropic::new(YOUNG, POISSON)?)?;
@@ -123,7 +124,7 @@ fn build(n: usize) -> Result<Model<PlateElements>> {
     dofs.fix(mesh.group_nodes("bottom")?, &[1, 4])?; // symmetry x2 = 0
     dofs.fix(mesh.group_nodes("right")?, &[2, 5])?; // simply supported: v3- = v3+ = 0
     dofs.fix(mesh.group_nodes("top")?, &[2, 5])?;
-    let mut model = Model::new(plate, dofs)?;
+    let mut model = Model::new(Plate::TwoSurface(plate), dofs)?;
     let z = 0.5 * THICKNESS;
     let sphere = Arc::new(Sphere::new(Vector3::new(0.0, 0.0, z + RADIUS), RADIUS)?);
     let areas = mesh.nodal_areas();

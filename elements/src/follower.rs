@@ -67,6 +67,8 @@ pub struct FollowerPressure {
     scale: Vec<f64>,
     /// Shape functions and their xi-derivatives at the 2 x 2 Gauss points (weight 1).
     gauss: [([f64; 4], [[f64; 2]; 4]); 4],
+    /// Unknowns per node of the plate (see [`Face::dof_in`]).
+    dofs_per_node: usize,
 }
 
 impl FollowerPressure {
@@ -86,7 +88,12 @@ impl FollowerPressure {
             scale.push(-s_face * orient * p);
         }
         let gauss = GAUSS_POINTS.map(|[s, t]| bilinear(s, t));
-        FollowerPressure { name: name.into(), face, cells: cells.to_vec(), x, scale, gauss }
+        FollowerPressure { name: name.into(), face, cells: cells.to_vec(), x, scale, gauss, dofs_per_node: crate::DOFS_PER_NODE }
+    }
+    /// The same on a plate with `n` unknowns per node (default: the paper's six).
+    pub fn with_dofs_per_node(mut self, n: usize) -> Self {
+        self.dofs_per_node = n;
+        self
     }
 }
 
@@ -101,7 +108,7 @@ impl DeformationDependentLoad for FollowerPressure {
             let mut x = *x0;
             for a in 0..4 {
                 for i in 0..3 {
-                    dof[a][i] = self.face.dof(cell[a], i);
+                    dof[a][i] = self.face.dof_in(self.dofs_per_node, cell[a], i);
                     x[a][i] += u[dof[a][i]];
                 }
             }
@@ -164,12 +171,19 @@ pub struct FollowerCouple {
     nodes: Vec<(usize, [f64; 3])>,
     /// The reference fibre h e3.
     h: f64,
+    /// Unknowns per node of the plate (see [`Face::dof_in`]).
+    dofs_per_node: usize,
 }
 
 impl FollowerCouple {
     /// Couples `nodes` = (node, m L_n) on a plate of thickness `h`.
     pub fn new(name: impl Into<String>, nodes: Vec<(usize, [f64; 3])>, h: f64) -> Self {
-        FollowerCouple { name: name.into(), nodes, h }
+        FollowerCouple { name: name.into(), nodes, h, dofs_per_node: crate::DOFS_PER_NODE }
+    }
+    /// The same on a plate with `n` unknowns per node (default: the paper's six).
+    pub fn with_dofs_per_node(mut self, n: usize) -> Self {
+        self.dofs_per_node = n;
+        self
     }
 }
 
@@ -180,8 +194,8 @@ impl DeformationDependentLoad for FollowerCouple {
 
     fn add_force_and_stiffness(&self, u: &[f64], force: &mut [f64], mut tangent: Option<&mut dyn FnMut(usize, usize, f64)>) {
         for &(node, m) in &self.nodes {
-            let top = [0, 1, 2].map(|i| Face::Top.dof(node, i));
-            let bottom = [0, 1, 2].map(|i| Face::Bottom.dof(node, i));
+            let top = [0, 1, 2].map(|i| Face::Top.dof_in(self.dofs_per_node, node, i));
+            let bottom = [0, 1, 2].map(|i| Face::Bottom.dof_in(self.dofs_per_node, node, i));
             let mut d = [0.0, 0.0, self.h];
             for i in 0..3 {
                 d[i] += u[top[i]] - u[bottom[i]];

@@ -39,9 +39,15 @@ impl Face {
             Face::Top => 1,
         }
     }
-    /// Global dof of displacement component `comp` (0, 1, 2) of this face at `node`.
+    /// Global dof of displacement component `comp` (0, 1, 2) of this face at `node`, in the
+    /// paper's plate (six dofs per node).
     pub fn dof(self, node: usize, comp: usize) -> usize {
-        node * DOFS_PER_NODE + 3 * self.index() + comp
+        self.dof_in(DOFS_PER_NODE, node, comp)
+    }
+    /// The same in a plate with `dofs_per_node` unknowns per node whose first six are the faces'
+    /// (the paper's plate: 6; the three-surface plate: 9, see [`crate::three_surface`]).
+    pub fn dof_in(self, dofs_per_node: usize, node: usize, comp: usize) -> usize {
+        node * dofs_per_node + 3 * self.index() + comp
     }
 }
 

@@ -6,8 +6,9 @@
 //! beta = (v+ - v-)/h, and the covariant tangents g_xi = X_,xi + v_,xi. So 2 E_ij = g_i . g_j -
 //! G_i . G_j (eq. 1.5 in vector form), which vanishes for any rigid motion because a rotation keeps
 //! dot products (eqs. 1.6-1.8). A [`Sample`] stores the value, gradient and (constant) Hessian of
-//! one such strain; the Hessian is a scalar 8 x 8 matrix over (node, face) pairs times the 3 x 3
-//! identity.
+//! one such strain; the Hessian is a scalar P x P matrix over the (node, surface) pairs times the
+//! 3 x 3 identity. P = 8 (4 nodes x 2 faces) for the paper's plate; the three-surface plate
+//! ([`crate::three_surface`]) uses the same types with P = 12.
 
 /// Element dofs: 4 nodes x 2 faces x 3 components; local dof 3k + i is component i of the
 /// displacement of (node, face) pair k = 2 node + face (face 0 = S-, 1 = S+).
@@ -15,20 +16,21 @@ pub const NDOF: usize = 24;
 /// (node, face) pairs.
 pub const NPAIR: usize = 8;
 
-/// A vector affine in the nodal face displacements: g = g0 + sum_k c_k v_k.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Affine {
+/// A vector affine in the nodal surface displacements: g = g0 + sum_k c_k v_k, k over the P
+/// (node, surface) pairs.
+#[derive(Debug, Clone, Copy)]
+pub struct Affine<const P: usize = NPAIR> {
     pub g0: [f64; 3],
     pub g: [f64; 3],
-    pub c: [f64; NPAIR],
+    pub c: [f64; P],
 }
 
-impl Affine {
+impl<const P: usize> Affine<P> {
     /// Build from the reference vector and the coefficients, evaluating g at `v`.
     #[inline(always)]
-    pub fn new(g0: [f64; 3], c: [f64; NPAIR], v: &[f64]) -> Self {
+    pub fn new(g0: [f64; 3], c: [f64; P], v: &[f64]) -> Self {
         let mut g = g0;
-        for k in 0..NPAIR {
+        for k in 0..P {
             if c[k] != 0.0 {
                 for i in 0..3 {
                     g[i] += c[k] * v[3 * k + i];
@@ -39,21 +41,23 @@ impl Affine {
     }
 }
 
-/// One strain: value, gradient with respect to the 24 element dofs, and its (constant) Hessian
-/// in factored form: s (a b^T + b a^T) over the (node, face) pairs, times the 3 x 3 identity.
+/// One strain: value, gradient with respect to the D = 3 P element dofs, and its (constant)
+/// Hessian in factored form: s (a b^T + b a^T) over the (node, surface) pairs, times the 3 x 3
+/// identity.
 #[derive(Debug, Clone, Copy)]
-pub struct Sample {
+pub struct Sample<const P: usize = NPAIR, const D: usize = NDOF> {
     pub val: f64,
-    pub grad: [f64; NDOF],
+    pub grad: [f64; D],
     /// Scale s of the Hessian (0 for a linear strain).
     pub scale: f64,
-    pub a: [f64; NPAIR],
-    pub b: [f64; NPAIR],
+    pub a: [f64; P],
+    pub b: [f64; P],
 }
 
-impl Default for Sample {
+impl<const P: usize, const D: usize> Default for Sample<P, D> {
     fn default() -> Self {
-        Sample { val: 0.0, grad: [0.0; NDOF], scale: 0.0, a: [0.0; NPAIR], b: [0.0; NPAIR] }
+        assert!(D == 3 * P, "a strain sample has three dofs per (node, surface) pair");
+        Sample { val: 0.0, grad: [0.0; D], scale: 0.0, a: [0.0; P], b: [0.0; P] }
     }
 }
 
@@ -62,12 +66,12 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-impl Sample {
+impl<const P: usize, const D: usize> Sample<P, D> {
     /// The full (Green-Lagrange) strain s (gA . gB - g0A . g0B).
     #[inline(always)]
-    pub fn quadratic(&mut self, s: f64, a: &Affine, b: &Affine) {
+    pub fn quadratic(&mut self, s: f64, a: &Affine<P>, b: &Affine<P>) {
         self.val = s * (dot(&a.g, &b.g) - dot(&a.g0, &b.g0));
-        for k in 0..NPAIR {
+        for k in 0..P {
             for i in 0..3 {
                 self.grad[3 * k + i] = s * (a.c[k] * b.g[i] + b.c[k] * a.g[i]);
             }
@@ -77,7 +81,7 @@ impl Sample {
         self.b = b.c;
     }
 
-    /// Hessian coefficient (k, l) over the (node, face) pairs.
+    /// Hessian coefficient (k, l) over the (node, surface) pairs.
     pub fn hessian(&self, k: usize, l: usize) -> f64 {
         self.scale * (self.a[k] * self.b[l] + self.b[k] * self.a[l])
     }
@@ -85,11 +89,11 @@ impl Sample {
     /// The part linear in the displacements, s (g0A . dB + g0B . dA) with d = g - g0: the strain of
     /// the geometrically linear theory (eta = 0). Its Hessian is zero.
     #[inline(always)]
-    pub fn linear(&mut self, s: f64, a: &Affine, b: &Affine) {
+    pub fn linear(&mut self, s: f64, a: &Affine<P>, b: &Affine<P>) {
         let da = [a.g[0] - a.g0[0], a.g[1] - a.g0[1], a.g[2] - a.g0[2]];
         let db = [b.g[0] - b.g0[0], b.g[1] - b.g0[1], b.g[2] - b.g0[2]];
         self.val = s * (dot(&a.g0, &db) + dot(&b.g0, &da));
-        for k in 0..NPAIR {
+        for k in 0..P {
             for i in 0..3 {
                 self.grad[3 * k + i] = s * (a.c[k] * b.g0[i] + b.c[k] * a.g0[i]);
             }

@@ -31,7 +31,8 @@
 //!   while nothing touches, the closest point pulls it down (see `ContactPair::evaluate`).
 
 use super::mesh::{group_error, MeshData};
-use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Problem, PunchFace, Shape};
+use super::plate_model::{Layout, Plate};
+use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, PlateModelSpec, Problem, PunchFace, Shape};
 use nalgebra::Vector3;
 use stamp::contact::{automatic_eps_reg, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
@@ -40,7 +41,7 @@ use stamp::nonlinear::NewtonSettings;
 use stamp::surface::ContactSurface;
 use stamp::{Result, StampError};
 use stamp_contact::{Cylinder, Expression, Plane, Sphere, StlSurface};
-use stamp_elements::{fixed_couple_force, Face, FollowerCouple, FollowerPressure, Isotropic, Kinematics, PlateElements, Section};
+use stamp_elements::{fixed_couple_force, Face, FollowerCouple, FollowerPressure, Isotropic, Kinematics, NormalStress, PlateElements, Section, ThreeSurfacePlate};
 use std::sync::Arc;
 
 /// Factor c of the automatic eps_reg (see the module notes).
@@ -60,7 +61,7 @@ pub struct PunchInfo {
 /// A model ready to solve and what the outputs need.
 pub struct Setup {
     pub mesh: MeshData,
-    pub model: Model<PlateElements>,
+    pub model: Model<Plate>,
     pub section: Section,
     pub punches: Vec<PunchInfo>,
     pub targets: Vec<f64>,
@@ -74,19 +75,24 @@ fn face_of(f: PunchFace) -> Face {
     }
 }
 
-/// Spread a nodal force over the faces.
-fn add_force(model: &mut Model<PlateElements>, node: usize, f: [f64; 3], face: LoadFace) -> Result<()> {
+/// Put a nodal force on a face, or on the mid-plane (the three-surface plate's own unknowns, or
+/// half on each face of the paper's plate).
+fn add_force(model: &mut Model<Plate>, node: usize, f: [f64; 3], face: LoadFace) -> Result<()> {
+    let layout = Layout::of(&model.element);
     for c in 0..3 {
         if f[c] == 0.0 {
             continue;
         }
         match face {
-            LoadFace::Mid => {
-                model.add_load(Face::Bottom.dof(node, c), 0.5 * f[c])?;
-                model.add_load(Face::Top.dof(node, c), 0.5 * f[c])?;
-            }
-            LoadFace::Top => model.add_load(Face::Top.dof(node, c), f[c])?,
-            LoadFace::Bottom => model.add_load(Face::Bottom.dof(node, c), f[c])?,
+            LoadFace::Mid => match layout.mid_dof(node, c) {
+                Some(d) => model.add_load(d, f[c])?,
+                None => {
+                    model.add_load(layout.face_dof(Face::Bottom, node, c), 0.5 * f[c])?;
+                    model.add_load(layout.face_dof(Face::Top, node, c), 0.5 * f[c])?;
+                }
+            },
+            LoadFace::Top => model.add_load(layout.face_dof(Face::Top, node, c), f[c])?,
+            LoadFace::Bottom => model.add_load(layout.face_dof(Face::Bottom, node, c), f[c])?,
         }
     }
     Ok(())
@@ -134,9 +140,12 @@ pub fn build(p: &Problem) -> Result<Setup> {
         StampError::Mesh(m) => p.error_at(s.mesh.span(), "mesh", m),
         e => e,
     })?;
-    // a gmsh mesh is read first (its size bounded by its file); refuse it before the model is built
-    if let Some(file) = &s.mesh.get_ref().file {
-        super::memory::check_model_fits(mesh.mesh.num_nodes() as u64).map_err(|m| p.error_at(file.span(), "mesh.file", m))?;
+    // a gmsh mesh is read first (its size bounded by its file); refuse it before the model is built,
+    // and a rectangle (checked for the paper's plate when read) too if the plate has more unknowns
+    let dofs_per_node = super::memory::dofs_per_node(s.plate.get_ref().model);
+    match &s.mesh.get_ref().file {
+        Some(file) => super::memory::check_model_fits(mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(file.span(), "mesh.file", m))?,
+        None => super::memory::check_model_fits(mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(s.mesh.span(), "mesh.rectangle", m))?,
     }
     build_on(p, mesh)
 }
@@ -163,23 +172,37 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         KinematicsSpec::Nonlinear => Kinematics::Nonlinear,
         KinematicsSpec::Linear => Kinematics::Linear,
     };
-    let plate = PlateElements::new(&mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?;
+    let plate = match ps.model {
+        PlateModelSpec::TwoSurface => Plate::TwoSurface(PlateElements::new(&mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?),
+        PlateModelSpec::ThreeSurface => {
+            let bad = if ps.shear_factor.is_some() { Some("shear_factor") } else if ps.normal_stress != NormalStress::Dropped { Some("normal_stress") } else { None };
+            if let Some(key) = bad {
+                return Err(p.error_at(
+                    s.plate.span(),
+                    &format!("plate.{key}"),
+                    "is a correction of the two-surface plate; model = \"three-surface\" has the full 3D law and takes no shear_factor or normal_stress",
+                ));
+            }
+            Plate::ThreeSurface(ThreeSurfacePlate::new(&mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?)
+        }
+    };
+    let layout = Layout::of(&plate);
 
     // constraints
-    let mut dofs = DofMap::new(n_nodes, 6)?;
+    let mut dofs = DofMap::new(n_nodes, layout.dofs_per_node)?;
     if ps.plane_strain {
         let all: Vec<usize> = (0..n_nodes).collect();
-        dofs.fix(&all, &[0, 3])?;
+        dofs.fix(&all, &layout.fibre_components(&[0, 3]))?;
     }
     for (i, b) in s.boundary.iter().enumerate() {
         let bs = b.get_ref();
         let key = format!("boundary[{i}].group");
         let name = bs.group.get_ref();
         let nodes = mesh.nodes(name).ok_or_else(|| group_error(p, bs.group.span(), &key, name, "", &mesh))?;
-        let comps: Vec<usize> = bs.fix.iter().flat_map(|d| d.components.clone()).collect();
+        let comps: Vec<usize> = layout.fibre_components(&bs.fix.iter().flat_map(|d| d.components.clone()).collect::<Vec<_>>());
         dofs.fix(&nodes, &comps).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}]"), e))?;
         for (k, v) in &bs.prescribe {
-            let comps = super::problem::dof_components(&k.0).expect("checked word");
+            let comps = layout.fibre_components(&super::problem::dof_components(&k.0).expect("checked word"));
             for &n in &nodes {
                 for &c in &comps {
                     dofs.prescribe(n, c, v.0).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}].prescribe"), e))?;
@@ -219,7 +242,9 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                     };
                     let quads: Vec<[usize; 4]> = cells.iter().map(|&c| mesh.mesh.cells[c]).collect();
                     let what = format!("follower pressure on '{}'", stamp::quote(name));
-                    model.add_follower_load(Box::new(FollowerPressure::new(what, &mesh.mesh.coords, &quads, f, z, ls.pressure.unwrap().0)));
+                    model.add_follower_load(Box::new(
+                        FollowerPressure::new(what, &mesh.mesh.coords, &quads, f, z, ls.pressure.unwrap().0).with_dofs_per_node(layout.dofs_per_node),
+                    ));
                     continue;
                 }
                 let f = match ls.kind {
@@ -251,7 +276,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                 let couples: Vec<(usize, [f64; 3])> = share.iter().enumerate().filter(|(_, &w)| w > 0.0).map(|(n, &w)| (n, m.map(|x| w * x))).collect();
                 if ls.follower {
                     let what = format!("follower couple on '{}'", stamp::quote(name));
-                    model.add_follower_load(Box::new(FollowerCouple::new(what, couples, h)));
+                    model.add_follower_load(Box::new(FollowerCouple::new(what, couples, h).with_dofs_per_node(layout.dofs_per_node)));
                 } else {
                     for (n, mn) in couples {
                         let f = fixed_couple_force(mn, h);
@@ -311,7 +336,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
             .iter()
             .map(|&n| {
                 let x = mesh.mesh.coords[n];
-                ContactPoint { node: n, x_ref: [x[0], x[1], z], dofs: [0, 1, 2].map(|c| face.dof(n, c)), weight: weights[n] }
+                ContactPoint { node: n, x_ref: [x[0], x[1], z], dofs: [0, 1, 2].map(|c| layout.face_dof(face, n, c)), weight: weights[n] }
             })
             .collect();
         let ck = match spec.kinematics {

@@ -413,7 +413,11 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
     let ps = s.plate.get_ref();
     let _ = writeln!(
         o,
-        "plate: thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}{}{}",
+        "plate: {}, thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}{}{}",
+        match setup.model.element {
+            super::plate_model::Plate::TwoSurface(_) => "two surfaces (the paper's plate)",
+            super::plate_model::Plate::ThreeSurface(_) => "three surfaces (faces and mid-plane, quadratic through the thickness, 3D law)",
+        },
         num(setup.section.thickness()),
         num(setup.section.delta_minus),
         num(setup.section.delta_plus),

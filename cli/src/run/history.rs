@@ -16,6 +16,7 @@ use super::units::Units;
 use stamp::contact::ContactPair;
 use stamp::io::write_string_atomically;
 use stamp::Result;
+use super::plate_model::Layout;
 use stamp_elements::Face;
 use std::path::{Path, PathBuf};
 
@@ -78,10 +79,6 @@ pub fn punch_row(pair: &ContactPair, face: Face, u: &[f64], t: f64) -> PunchRow 
     }
 }
 
-/// Mid-surface displacement (v- + v+)/2 of node `n`.
-pub fn mid_displacement(u: &[f64], n: usize) -> [f64; 3] {
-    [0, 1, 2].map(|c| 0.5 * (u[Face::Bottom.dof(n, c)] + u[Face::Top.dof(n, c)]))
-}
 
 /// The rows of a run so far and what names its columns.
 #[derive(Debug, Clone)]
@@ -94,6 +91,8 @@ pub struct History {
     /// Named point groups (name, nodes).
     pub points: Vec<(String, Vec<usize>)>,
     pub rows: Vec<HistoryRow>,
+    /// Where the plate keeps its surfaces' displacements among the unknowns.
+    pub layout: Layout,
 }
 
 impl History {
@@ -106,7 +105,14 @@ impl History {
             label_by_force: punches.iter().map(|p| p.2).collect(),
             points: point_groups.iter().filter(|(k, _)| !k.starts_with('#')).cloned().collect(),
             rows: Vec::new(),
+            layout: Layout::TWO_SURFACE,
         }
+    }
+
+    /// The same for a plate with another layout of its unknowns (the three-surface plate's).
+    pub fn with_layout(mut self, layout: Layout) -> History {
+        self.layout = layout;
+        self
     }
 
     /// Add the converged step `step` (unknowns `u`, load factor `t`, path length `path`).
@@ -118,7 +124,7 @@ impl History {
             .map(|(_, nodes)| {
                 let mut s = [0.0; 3];
                 for &k in nodes {
-                    let v = mid_displacement(u, k);
+                    let v = self.layout.mid_displacement(u, k);
                     for i in 0..3 {
                         s[i] += v[i] / nodes.len() as f64;
                     }
@@ -126,9 +132,9 @@ impl History {
                 s
             })
             .collect();
-        // u holds six face displacements per node, then one unknown per force-driven punch
-        let nodes = (u.len() - contacts.iter().filter(|c| c.drive.is_some()).count()) / 6;
-        let max_deflection = (0..nodes).map(|n| mid_displacement(u, n)[2]).fold(0.0f64, |m, w| if w.abs() > m.abs() { w } else { m });
+        // u holds the surfaces' displacements node by node, then one unknown per force-driven punch
+        let nodes = (u.len() - contacts.iter().filter(|c| c.drive.is_some()).count()) / self.layout.dofs_per_node;
+        let max_deflection = (0..nodes).map(|n| self.layout.mid_displacement(u, n)[2]).fold(0.0f64, |m, w| if w.abs() > m.abs() { w } else { m });
         self.rows.push(HistoryRow { step, load_factor: t, path, newton_iterations, punches, points, max_deflection });
         self.rows.last().expect("just pushed")
     }

@@ -19,6 +19,7 @@ pub mod memory;
 pub mod mesh;
 pub mod out_dir;
 pub mod output;
+pub mod plate_model;
 pub mod plot;
 pub mod probe;
 pub mod problem;

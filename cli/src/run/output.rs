@@ -26,7 +26,8 @@ use serde::Serialize;
 use stamp::element::Element;
 use stamp::io::Field;
 use stamp::model::Model;
-use stamp_elements::{Face, PlateElements, Section};
+use super::plate_model::{Layout, Plate};
+use stamp_elements::{Face, PlateElements, Section, ThreeSurfacePlate};
 use std::collections::BTreeMap;
 
 /// Names of the point arrays of every .vtu (gap only with punches).
@@ -135,18 +136,16 @@ pub struct ContactRow {
     pub active: bool,
 }
 
-fn face_disp(u: &[f64], n: usize, face: Face) -> [f64; 3] {
-    [0, 1, 2].map(|c| u[face.dof(n, c)])
-}
-
-fn mid_disp(u: &[f64], n: usize) -> [f64; 3] {
-    let (b, t) = (face_disp(u, n, Face::Bottom), face_disp(u, n, Face::Top));
-    [0, 1, 2].map(|c| 0.5 * (b[c] + t[c]))
-}
-
 /// Stress resultants at the element centres.
-pub fn cell_fields(model: &Model<PlateElements>, section: &Section, u: &[f64]) -> Vec<Field> {
-    let plate = &model.element;
+pub fn cell_fields(model: &Model<Plate>, section: &Section, u: &[f64]) -> Vec<Field> {
+    match &model.element {
+        Plate::TwoSurface(plate) => two_surface_cell_fields(plate, section, u),
+        Plate::ThreeSurface(plate) => three_surface_cell_fields(plate, u),
+    }
+}
+
+/// The resultants of the paper's plate from its face resultants T- and T+ (eq. 2.7).
+fn two_surface_cell_fields(plate: &PlateElements, section: &Section, u: &[f64]) -> Vec<Field> {
     let mut ws = plate.new_workspace();
     let ne = plate.num_elements();
     let half_h = 0.5 * section.thickness();
@@ -181,6 +180,26 @@ pub fn cell_fields(model: &Model<PlateElements>, section: &Section, u: &[f64]) -
     CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect()
 }
 
+/// The resultants of the three-surface plate, integrated through the thickness.
+fn three_surface_cell_fields(plate: &ThreeSurfacePlate, u: &[f64]) -> Vec<Field> {
+    let mut ws = plate.new_workspace();
+    let ne = plate.num_elements();
+    let dpn = plate.dofs_per_node();
+    let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(ne); 9];
+    let mut local = vec![0.0; 4 * dpn];
+    for e in 0..ne {
+        for (a, &n) in plate.element_nodes(e).iter().enumerate() {
+            local[dpn * a..dpn * (a + 1)].copy_from_slice(&u[dpn * n..dpn * (n + 1)]);
+        }
+        let r = plate.resultants(e, &local, &mut ws);
+        let vals = [r.n[0], r.n[1], r.n[2], r.m[0], r.m[1], r.m[2], r.q[0], r.q[1], r.t33];
+        for (k, v) in vals.iter().enumerate() {
+            out[k].push(*v);
+        }
+    }
+    CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect()
+}
+
 /// Inputs of [`step_data`] that do not change from step to step.
 pub struct Context<'a> {
     pub mesh: &'a MeshData,
@@ -192,7 +211,10 @@ pub struct Context<'a> {
 }
 
 /// Fields, summary entry and CSV rows of the state `u` at load factor `t`.
-pub fn step_data(cx: &Context, model: &Model<PlateElements>, u: &[f64], t: f64, path: f64, report: &stamp::nonlinear::StepReport) -> StepData {
+pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f64, report: &stamp::nonlinear::StepReport) -> StepData {
+    let layout = Layout::of(&model.element);
+    let face_disp = |u: &[f64], n: usize, face: Face| layout.face_displacement(u, n, face);
+    let mid_disp = |u: &[f64], n: usize| layout.mid_displacement(u, n);
     let n = cx.mesh.mesh.num_nodes();
     let coords = &cx.mesh.mesh.coords;
     let mut lambda = vec![0.0; n];

@@ -23,7 +23,8 @@
 //! point: the active node of the first written step closest to the pressure-weighted centre of its
 //! active nodes, or, when nothing touches yet, the node closest to the punch.
 
-use super::history::{mid_displacement, sig4, History, HistoryRow};
+use super::history::{sig4, History, HistoryRow};
+use super::plate_model::Layout;
 use super::mesh::MeshData;
 use super::plot::{write_plot, Plot, Series};
 use super::problem::Problem;
@@ -386,13 +387,13 @@ impl<'a> Probes<'a> {
     }
 
     /// Write `probe_<name>_<step>.csv` of every probe for the state `u` and keep the curves.
-    pub fn write_step(&mut self, dir: &Path, step: usize, row: &HistoryRow, punch_names: &[String], contacts: &[ContactPair], u: &[f64]) -> Result<Vec<PathBuf>> {
+    pub fn write_step(&mut self, dir: &Path, step: usize, row: &HistoryRow, punch_names: &[String], contacts: &[ContactPair], layout: &Layout, u: &[f64]) -> Result<Vec<PathBuf>> {
         self.place_default(contacts);
         let nn = self.mesh.num_nodes();
         let q: Vec<Vec<f64>> = contacts.iter().map(|c| nodal_pressure(c, nn)).collect();
         let mut files = Vec::new();
         for (line, curves) in self.lines.iter().zip(&mut self.curves) {
-            let disp: Vec<Vec<f64>> = (0..3).map(|i| line.interpolate(|n| mid_displacement(u, n)[i])).collect();
+            let disp: Vec<Vec<f64>> = (0..3).map(|i| line.interpolate(|n| layout.mid_displacement(u, n)[i])).collect();
             let qs: Vec<Vec<f64>> = q.iter().map(|qk| line.interpolate(|n| qk[n])).collect();
             let mut csv = String::from("distance,x1,x2,u1,u2,u3");
             for n in punch_names {

@@ -383,7 +383,7 @@ impl RectangleSpec {
         }
         let (nx, ny) = (n[0] as u64, n[1] as u64);
         let nodes = (nx + 1).checked_mul(ny + 1).ok_or_else(|| format!("mesh.rectangle.n: [{nx}, {ny}] gives more nodes than this machine can count"))?;
-        super::memory::check_model_fits(nodes).map_err(|e| format!("mesh.rectangle.n: [{nx}, {ny}]: {e}"))?;
+        super::memory::check_model_fits(nodes, super::memory::DOFS_PER_NODE).map_err(|e| format!("mesh.rectangle.n: [{nx}, {ny}]: {e}"))?;
         Ok([nx as usize, ny as usize])
     }
 }
@@ -429,6 +429,21 @@ pub struct PlateSpec {
     /// How S_33 enters the in-plane law: "dropped" (default, b_ab33 = 0) or "mean".
     #[serde(default)]
     pub normal_stress: stamp_elements::NormalStress,
+    /// The plate model: "two-surface" (default, the paper's) or "three-surface".
+    #[serde(default)]
+    pub model: PlateModelSpec,
+}
+
+/// `[plate] model`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlateModelSpec {
+    /// The paper's plate: the two face planes' displacements (six per node), linear through the
+    /// thickness.
+    #[default]
+    TwoSurface,
+    /// Faces and mid-plane (nine per node), quadratic through the thickness, the full 3D law.
+    ThreeSurface,
 }
 
 #[derive(Debug, Deserialize)]

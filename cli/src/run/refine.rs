@@ -56,11 +56,11 @@ pub fn level_folder(level: usize) -> String {
     }
 }
 
-/// Ok if the problem's mesh refined 1 ..= levels times fits in `available` bytes (None: unknown);
-/// else what the largest that fits is and what to do.
-pub fn check_levels_fit(sizes: &[(u64, u64)], levels: usize, available: Option<f64>) -> std::result::Result<(), String> {
+/// Ok if the problem's mesh refined 1 ..= levels times fits in `available` bytes (None: unknown)
+/// with `dofs_per_node` unknowns per node; else what the largest that fits is and what to do.
+pub fn check_levels_fit(sizes: &[(u64, u64)], levels: usize, dofs_per_node: u64, available: Option<f64>) -> std::result::Result<(), String> {
     for (k, &(nodes, _)) in sizes.iter().enumerate() {
-        if let Err(m) = super::memory::check_against(nodes, available) {
+        if let Err(m) = super::memory::check_against(nodes, dofs_per_node, available) {
             let advice = if k == 0 { "solve without --refine".to_string() } else { format!("use --refine {k}") };
             return Err(format!("--refine {levels}: the mesh refined {}: {m}; or {advice}", times(k + 1)));
         }
@@ -99,7 +99,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     }
     // every refined model must fit before anything is solved
     let sizes = stamp::mesh_refine::refined_sizes(&setup.mesh.mesh, levels);
-    check_levels_fit(&sizes, levels, super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
+    check_levels_fit(&sizes, levels, super::memory::dofs_per_node(p.spec.plate.get_ref().model), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
     let units = Units::new(p.spec.units.as_ref());
     let force_driven: Vec<bool> = p.spec.punch.iter().map(|s| s.get_ref().force.is_some()).collect();
@@ -237,11 +237,11 @@ mod tests {
         let sizes = stamp::mesh_refine::refined_sizes(&mesh, 3);
         assert_eq!(sizes.iter().map(|s| s.0).collect::<Vec<_>>(), [201 * 201, 401 * 401, 801 * 801]);
         // estimates: 1.44, 6.13 and 26.8 GiB
-        assert!(check_levels_fit(&sizes, 3, Some(64.0 * GIB)).is_ok());
-        assert!(check_levels_fit(&sizes[..2], 2, Some(10.0 * GIB)).is_ok());
-        let e = check_levels_fit(&sizes, 3, Some(10.0 * GIB)).unwrap_err();
+        assert!(check_levels_fit(&sizes, 3, 6, Some(64.0 * GIB)).is_ok());
+        assert!(check_levels_fit(&sizes[..2], 2, 6, Some(10.0 * GIB)).is_ok());
+        let e = check_levels_fit(&sizes, 3, 6, Some(10.0 * GIB)).unwrap_err();
         assert!(e.contains("--refine 3: the mesh refined 3 times: the model has 641601 nodes") && e.contains("use --refine 2"), "{e}");
-        let e = check_levels_fit(&sizes[..1], 1, Some(1.0 * GIB)).unwrap_err();
+        let e = check_levels_fit(&sizes[..1], 1, 6, Some(1.0 * GIB)).unwrap_err();
         assert!(e.contains("refined once") && e.contains("solve without --refine"), "{e}");
     }
 }

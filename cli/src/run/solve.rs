@@ -4,6 +4,7 @@
 use super::build::Setup;
 use super::output::{contact_csv, step_data, Context};
 use super::history::History;
+use super::plate_model::Layout;
 use serde_json::Value;
 use super::probe::Probes;
 use super::problem::{PlotAxis, Problem};
@@ -81,6 +82,8 @@ struct Summary {
     nodes: usize,
     cells: usize,
     equations: usize,
+    /// `[plate] model`: "two-surface" or "three-surface".
+    plate_model: String,
     thickness: f64,
     delta_minus: f64,
     delta_plus: f64,
@@ -258,7 +261,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let units = Units::new(p.spec.units.as_ref());
     let punch_names: Vec<String> = punches.iter().map(|i| i.name.clone()).collect();
     let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.is_some() || c.motion.is_zero())).collect();
-    let mut history = History::new(&punch_keys, &point_groups);
+    let mut history = History::new(&punch_keys, &point_groups).with_layout(Layout::of(&model.element));
     let mut probes = Probes::new(p, &mesh, &out.probe, &punch_names)?;
 
     let mut summary = Summary {
@@ -271,6 +274,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         nodes: mesh.mesh.num_nodes(),
         cells: mesh.mesh.num_cells(),
         equations: model.dofs.num_equations(),
+        plate_model: model.element.name().into(),
         thickness: section.thickness(),
         delta_minus: section.delta_minus,
         delta_plus: section.delta_plus,
@@ -378,7 +382,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
                     data.entry.csv.push(name);
                 }
             }
-            for path in probes.write_step(out_dir, rep.step, &row, &punch_names, &m.contacts, u)? {
+            for path in probes.write_step(out_dir, rep.step, &row, &punch_names, &m.contacts, &history.layout, u)? {
                 data.entry.csv.push(path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default());
                 written.push(path);
             }
