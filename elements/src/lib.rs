@@ -11,9 +11,9 @@ pub mod geometry;
 pub mod material;
 pub mod plate;
 pub mod strain;
-pub mod three_surface;
+pub mod multi_surface;
 
 pub use follower::{fixed_couple_force, FollowerCouple, FollowerPressure};
 pub use material::{Isotropic, Layer, NormalStress, Section};
 pub use plate::{Face, Kinematics, PlateElements, DOFS_PER_NODE};
-pub use three_surface::ThreeSurfacePlate;
+pub use multi_surface::{FiveSurfacePlate, FourSurfacePlate, MultiSurfacePlate, ThreeSurfacePlate};

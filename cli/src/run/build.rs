@@ -32,7 +32,7 @@
 
 use super::mesh::{group_error, MeshData};
 use super::plate_model::{Layout, Plate};
-use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, PlateModelSpec, Problem, PunchFace, Shape};
+use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Problem, PunchFace, Shape};
 use nalgebra::Vector3;
 use stamp::contact::{automatic_eps_reg, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
@@ -41,7 +41,7 @@ use stamp::nonlinear::NewtonSettings;
 use stamp::surface::ContactSurface;
 use stamp::{Result, StampError};
 use stamp_contact::{Cylinder, Expression, Plane, Sphere, StlSurface};
-use stamp_elements::{fixed_couple_force, Face, FollowerCouple, FollowerPressure, Isotropic, Kinematics, NormalStress, PlateElements, Section, ThreeSurfacePlate};
+use stamp_elements::{fixed_couple_force, Face, FollowerCouple, FollowerPressure, Isotropic, Kinematics, NormalStress, Section};
 use std::sync::Arc;
 
 /// Factor c of the automatic eps_reg (see the module notes).
@@ -75,8 +75,8 @@ fn face_of(f: PunchFace) -> Face {
     }
 }
 
-/// Put a nodal force on a face, or on the mid-plane (the three-surface plate's own unknowns, or
-/// half on each face of the paper's plate).
+/// Put a nodal force on a face, or on the mid-plane (half on each face of the paper's plate, on
+/// each surface its weight in the mid-plane's displacement in the others).
 fn add_force(model: &mut Model<Plate>, node: usize, f: [f64; 3], face: LoadFace) -> Result<()> {
     let layout = Layout::of(&model.element);
     for c in 0..3 {
@@ -84,13 +84,12 @@ fn add_force(model: &mut Model<Plate>, node: usize, f: [f64; 3], face: LoadFace)
             continue;
         }
         match face {
-            LoadFace::Mid => match layout.mid_dof(node, c) {
-                Some(d) => model.add_load(d, f[c])?,
-                None => {
-                    model.add_load(layout.face_dof(Face::Bottom, node, c), 0.5 * f[c])?;
-                    model.add_load(layout.face_dof(Face::Top, node, c), 0.5 * f[c])?;
+            LoadFace::Mid => {
+                // a force at the mid-plane: on each surface its weight in the mid-plane's displacement
+                for (d, w) in layout.mid_terms(node, c) {
+                    model.add_load(d, w * f[c])?;
                 }
-            },
+            }
             LoadFace::Top => model.add_load(layout.face_dof(Face::Top, node, c), f[c])?,
             LoadFace::Bottom => model.add_load(layout.face_dof(Face::Bottom, node, c), f[c])?,
         }
@@ -142,7 +141,7 @@ pub fn build(p: &Problem) -> Result<Setup> {
     })?;
     // a gmsh mesh is read first (its size bounded by its file); refuse it before the model is built,
     // and a rectangle (checked for the paper's plate when read) too if the plate has more unknowns
-    let dofs_per_node = super::memory::dofs_per_node(s.plate.get_ref().model);
+    let dofs_per_node = super::memory::dofs_per_node(s.plate.get_ref().surfaces);
     match &s.mesh.get_ref().file {
         Some(file) => super::memory::check_model_fits(mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(file.span(), "mesh.file", m))?,
         None => super::memory::check_model_fits(mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(s.mesh.span(), "mesh.rectangle", m))?,
@@ -172,20 +171,18 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         KinematicsSpec::Nonlinear => Kinematics::Nonlinear,
         KinematicsSpec::Linear => Kinematics::Linear,
     };
-    let plate = match ps.model {
-        PlateModelSpec::TwoSurface => Plate::TwoSurface(PlateElements::new(&mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?),
-        PlateModelSpec::ThreeSurface => {
-            let bad = if ps.shear_factor.is_some() { Some("shear_factor") } else if ps.normal_stress != NormalStress::Dropped { Some("normal_stress") } else { None };
-            if let Some(key) = bad {
-                return Err(p.error_at(
-                    s.plate.span(),
-                    &format!("plate.{key}"),
-                    "is a correction of the two-surface plate; model = \"three-surface\" has the full 3D law and takes no shear_factor or normal_stress",
-                ));
-            }
-            Plate::ThreeSurface(ThreeSurfacePlate::new(&mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?)
+    let surfaces = ps.surfaces.0;
+    if surfaces > 2 {
+        let bad = if ps.shear_factor.is_some() { Some("shear_factor") } else if ps.normal_stress != NormalStress::Dropped { Some("normal_stress") } else { None };
+        if let Some(key) = bad {
+            return Err(p.error_at(
+                s.plate.span(),
+                &format!("plate.{key}"),
+                format!("is a correction of the two-surface plate; with surfaces = {surfaces} the plate has the full 3D law and takes no shear_factor or normal_stress"),
+            ));
         }
-    };
+    }
+    let plate = Plate::new(surfaces, &mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?;
     let layout = Layout::of(&plate);
 
     // constraints

@@ -224,10 +224,12 @@ fn check_rigid_modes(p: &Problem, setup: &Setup, starts: &[PunchStart], size: f6
     let coords = &setup.mesh.mesh.coords;
     let dofs = &setup.model.dofs;
     let per = dofs.dofs_per_node();
+    let layout = super::plate_model::Layout::of(&setup.model.element);
     for (d, &e) in dofs.equations().iter().enumerate() {
         if e == PRESCRIBED {
             let (n, c) = (d / per, d % per);
-            let z = if c < 3 { dm } else { dp };
+            // components 0-2: S-, 3-5: S+, then the inner surfaces'
+            let z = 0.5 * (dm + dp) + 0.5 * (dp - dm) * layout.zeta_of_component(c);
             modes.hold_component([coords[n][0], coords[n][1], z], c % 3);
         }
     }
@@ -414,9 +416,9 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
     let _ = writeln!(
         o,
         "plate: {}, thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}{}{}",
-        match setup.model.element {
-            super::plate_model::Plate::TwoSurface(_) => "two surfaces (the paper's plate)",
-            super::plate_model::Plate::ThreeSurface(_) => "three surfaces (faces and mid-plane, quadratic through the thickness, 3D law)",
+        match setup.model.element.surfaces() {
+            2 => "two surfaces (the paper's plate)".to_string(),
+            n => format!("{n} surfaces (displacement of degree {} through the thickness, 3D law)", n - 1),
         },
         num(setup.section.thickness()),
         num(setup.section.delta_minus),

@@ -105,7 +105,7 @@ impl History {
             label_by_force: punches.iter().map(|p| p.2).collect(),
             points: point_groups.iter().filter(|(k, _)| !k.starts_with('#')).cloned().collect(),
             rows: Vec::new(),
-            layout: Layout::TWO_SURFACE,
+            layout: Layout::two_surface(),
         }
     }
 

@@ -12,12 +12,9 @@
 /// Unknowns per node of the paper's plate (three displacements on each face): what the problem
 /// file's mesh is checked against before its model is known.
 pub const DOFS_PER_NODE: u64 = 6;
-/// Unknowns per node of the plate model a problem file chooses.
-pub fn dofs_per_node(model: super::problem::PlateModelSpec) -> u64 {
-    match model {
-        super::problem::PlateModelSpec::TwoSurface => DOFS_PER_NODE,
-        super::problem::PlateModelSpec::ThreeSurface => stamp_elements::three_surface::DOFS_PER_NODE as u64,
-    }
+/// Unknowns per node of the plate a problem file chooses (three per surface).
+pub fn dofs_per_node(surfaces: super::problem::Surfaces) -> u64 {
+    3 * surfaces.0 as u64
 }
 
 /// Bytes per unknown and per factor of log2(unknowns) (see the calibration above).

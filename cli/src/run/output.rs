@@ -27,7 +27,7 @@ use stamp::element::Element;
 use stamp::io::Field;
 use stamp::model::Model;
 use super::plate_model::{Layout, Plate};
-use stamp_elements::{Face, PlateElements, Section, ThreeSurfacePlate};
+use stamp_elements::{Face, PlateElements, Section};
 use std::collections::BTreeMap;
 
 /// Names of the point arrays of every .vtu (gap only with punches).
@@ -140,7 +140,7 @@ pub struct ContactRow {
 pub fn cell_fields(model: &Model<Plate>, section: &Section, u: &[f64]) -> Vec<Field> {
     match &model.element {
         Plate::TwoSurface(plate) => two_surface_cell_fields(plate, section, u),
-        Plate::ThreeSurface(plate) => three_surface_cell_fields(plate, u),
+        plate => multi_surface_cell_fields(plate, u),
     }
 }
 
@@ -180,8 +180,8 @@ fn two_surface_cell_fields(plate: &PlateElements, section: &Section, u: &[f64]) 
     CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect()
 }
 
-/// The resultants of the three-surface plate, integrated through the thickness.
-fn three_surface_cell_fields(plate: &ThreeSurfacePlate, u: &[f64]) -> Vec<Field> {
+/// The resultants of a plate of more than two surfaces, integrated through the thickness.
+fn multi_surface_cell_fields(plate: &Plate, u: &[f64]) -> Vec<Field> {
     let mut ws = plate.new_workspace();
     let ne = plate.num_elements();
     let dpn = plate.dofs_per_node();
@@ -191,7 +191,7 @@ fn three_surface_cell_fields(plate: &ThreeSurfacePlate, u: &[f64]) -> Vec<Field>
         for (a, &n) in plate.element_nodes(e).iter().enumerate() {
             local[dpn * a..dpn * (a + 1)].copy_from_slice(&u[dpn * n..dpn * (n + 1)]);
         }
-        let r = plate.resultants(e, &local, &mut ws);
+        let r = plate.multi_surface_resultants(e, &local, &mut ws).expect("a plate of more than two surfaces");
         let vals = [r.n[0], r.n[1], r.n[2], r.m[0], r.m[1], r.m[2], r.q[0], r.q[1], r.t33];
         for (k, v) in vals.iter().enumerate() {
             out[k].push(*v);

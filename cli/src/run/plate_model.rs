@@ -1,11 +1,15 @@
-//! The plate model a problem file chooses (`[plate] model`): the paper's two-surface plate or the
-//! three-surface plate, both plug-ins of the elements crate, behind one [`Element`] for the rest
-//! of the run, with where each keeps its surfaces' displacements among the unknowns.
+//! The plate model a problem file chooses (`[plate] surfaces`): the paper's two-surface plate or a
+//! plate of three to five surfaces through the thickness, plug-ins of the elements crate, behind
+//! one [`Element`] for the rest of the run, with where each keeps its surfaces' displacements
+//! among the unknowns ([`Layout`]).
 
 use stamp::element::{Element, LocalSystem};
+use stamp::mesh::QuadMesh;
+use stamp::Result;
+use stamp_elements::multi_surface::{lagrange, surface_zetas, MultiSurfaceWorkspace, Resultants};
 use stamp_elements::plate::PlateWorkspace;
-use stamp_elements::three_surface::ThreeSurfaceWorkspace;
-use stamp_elements::{Face, Kinematics, PlateElements, ThreeSurfacePlate};
+use stamp_elements::{FiveSurfacePlate, FourSurfacePlate, Kinematics, PlateElements, Section, ThreeSurfacePlate};
+use stamp_elements::Face;
 
 /// The plate elements of a run.
 pub enum Plate {
@@ -13,79 +17,115 @@ pub enum Plate {
     TwoSurface(PlateElements),
     /// Faces and mid-plane: quadratic through the thickness, the full 3D law.
     ThreeSurface(ThreeSurfacePlate),
+    /// Faces and two inner surfaces: cubic through the thickness.
+    FourSurface(FourSurfacePlate),
+    /// Faces and three inner surfaces: quartic through the thickness.
+    FiveSurface(FiveSurfacePlate),
 }
 
-/// The workspace of either.
+/// The workspace of any of them.
 pub enum PlateWs {
     TwoSurface(PlateWorkspace),
-    ThreeSurface(ThreeSurfaceWorkspace),
+    ThreeSurface(MultiSurfaceWorkspace<12, 36>),
+    FourSurface(MultiSurfaceWorkspace<16, 48>),
+    FiveSurface(MultiSurfaceWorkspace<20, 60>),
+}
+
+/// Dispatch `$body` on the plate's variant with the element bound to `$p`.
+macro_rules! each {
+    ($plate:expr, $p:ident => $body:expr) => {
+        match $plate {
+            Plate::TwoSurface($p) => $body,
+            Plate::ThreeSurface($p) => $body,
+            Plate::FourSurface($p) => $body,
+            Plate::FiveSurface($p) => $body,
+        }
+    };
 }
 
 impl Plate {
-    /// Unknowns per node.
-    pub fn dofs_per_node(&self) -> usize {
-        match self {
-            Plate::TwoSurface(p) => p.dofs_per_node(),
-            Plate::ThreeSurface(p) => p.dofs_per_node(),
-        }
+    /// The plate of `surfaces` surfaces (2 to 5) on `mesh`.
+    pub fn new(surfaces: usize, mesh: &QuadMesh, section: Section, kinematics: Kinematics) -> Result<Plate> {
+        Ok(match surfaces {
+            2 => Plate::TwoSurface(PlateElements::new(mesh, section, kinematics)?),
+            3 => Plate::ThreeSurface(ThreeSurfacePlate::new(mesh, section, kinematics)?),
+            4 => Plate::FourSurface(FourSurfacePlate::new(mesh, section, kinematics)?),
+            5 => Plate::FiveSurface(FiveSurfacePlate::new(mesh, section, kinematics)?),
+            n => return Err(stamp::StampError::Material(format!("a plate has 2 to 5 surfaces, not {n}"))),
+        })
+    }
+    /// Surfaces through the thickness.
+    pub fn surfaces(&self) -> usize {
+        Element::dofs_per_node(self) / 3
     }
     pub fn kinematics(&self) -> Kinematics {
-        match self {
-            Plate::TwoSurface(p) => p.kinematics(),
-            Plate::ThreeSurface(p) => p.kinematics(),
-        }
+        each!(self, p => p.kinematics())
     }
-    /// The model's name in the problem file.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Plate::TwoSurface(_) => "two-surface",
-            Plate::ThreeSurface(_) => "three-surface",
+    /// The resultants at the centre of element `e` of a plate of more than two surfaces, at the
+    /// local dofs `v`; None for the paper's plate (its resultants come from its own face
+    /// resultants).
+    pub fn multi_surface_resultants(&self, e: usize, v: &[f64], ws: &mut PlateWs) -> Option<Resultants> {
+        match (self, ws) {
+            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => Some(p.resultants(e, v, w)),
+            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => Some(p.resultants(e, v, w)),
+            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => Some(p.resultants(e, v, w)),
+            _ => None,
         }
     }
 }
 
-/// Where the surfaces' displacements are among the unknowns.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Where the surfaces' displacements are among the unknowns: per node, the faces S- and S+ first
+/// (three components each), then the inner surfaces from the bottom up.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Layout {
+    pub surfaces: usize,
     pub dofs_per_node: usize,
+    /// Weights of the surfaces' displacements in the mid-plane's (the Lagrange functions at zeta = 0).
+    mid_weights: Vec<f64>,
 }
 
 impl Layout {
-    pub fn of(plate: &Plate) -> Self {
-        Layout { dofs_per_node: plate.dofs_per_node() }
+    pub fn new(surfaces: usize) -> Layout {
+        let mid_weights = if surfaces == 2 { vec![0.5, 0.5] } else { lagrange(&surface_zetas(surfaces), 0.0).0 };
+        Layout { surfaces, dofs_per_node: 3 * surfaces, mid_weights }
+    }
+    pub fn of(plate: &Plate) -> Layout {
+        Layout::new(plate.surfaces())
     }
     /// The paper's six unknowns per node.
-    pub const TWO_SURFACE: Layout = Layout { dofs_per_node: stamp_elements::DOFS_PER_NODE };
+    pub fn two_surface() -> Layout {
+        Layout::new(2)
+    }
     /// Global dof of component `comp` of `face` at `node`.
     pub fn face_dof(&self, face: Face, node: usize, comp: usize) -> usize {
         face.dof_in(self.dofs_per_node, node, comp)
-    }
-    /// Global dof of component `comp` of the mid-plane at `node`, in a plate that has it.
-    pub fn mid_dof(&self, node: usize, comp: usize) -> Option<usize> {
-        (self.dofs_per_node == stamp_elements::three_surface::DOFS_PER_NODE).then(|| node * self.dofs_per_node + 6 + comp)
     }
     /// Displacement of `face` at node `n`.
     pub fn face_displacement(&self, u: &[f64], n: usize, face: Face) -> [f64; 3] {
         [0, 1, 2].map(|c| u[self.face_dof(face, n, c)])
     }
-    /// Displacement of the mid-plane at node `n`: the mid-plane's own unknowns where the plate has
-    /// them, otherwise (v- + v+)/2 (the paper's displacement is linear through the thickness).
+    /// The mid-plane's displacement at node `n` as weights of its surfaces' unknowns: (dof, weight)
+    /// per surface for component `comp` ((v- + v+)/2 in the paper's plate, the displacement
+    /// interpolated at zeta = 0 in the others: the mid-plane's own unknowns with three surfaces).
+    pub fn mid_terms(&self, node: usize, comp: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.mid_weights.iter().enumerate().filter(|(_, &w)| w != 0.0).map(move |(s, &w)| (node * self.dofs_per_node + 3 * s + comp, w))
+    }
+    /// Displacement of the mid-plane at node `n`.
     pub fn mid_displacement(&self, u: &[f64], n: usize) -> [f64; 3] {
-        match self.mid_dof(n, 0) {
-            Some(d) => [u[d], u[d + 1], u[d + 2]],
-            None => [0, 1, 2].map(|c| 0.5 * (u[self.face_dof(Face::Bottom, n, c)] + u[self.face_dof(Face::Top, n, c)])),
-        }
+        [0, 1, 2].map(|c| self.mid_terms(n, c).map(|(d, w)| w * u[d]).sum())
+    }
+    /// zeta in [-1, 1] of the surface that holds component `c` (0 .. dofs per node) of a node.
+    pub fn zeta_of_component(&self, c: usize) -> f64 {
+        surface_zetas(self.surfaces)[c / 3]
     }
     /// The constrained components of a boundary word, extended to this plate: a word that holds a
     /// component on both faces (v1, symmetry_x1, simply_supported, clamped, ...) holds it on the
-    /// mid-plane too, i.e. on the whole fibre.
+    /// inner surfaces too, i.e. on the whole fibre.
     pub fn fibre_components(&self, comps: &[usize]) -> Vec<usize> {
         let mut out = comps.to_vec();
-        if self.mid_dof(0, 0).is_some() {
-            for c in 0..3 {
-                if comps.contains(&c) && comps.contains(&(c + 3)) {
-                    out.push(6 + c);
-                }
+        for c in 0..3 {
+            if comps.contains(&c) && comps.contains(&(c + 3)) {
+                out.extend((2..self.surfaces).map(|s| 3 * s + c));
             }
         }
         out
@@ -96,40 +136,59 @@ impl Element for Plate {
     type Workspace = PlateWs;
 
     fn dofs_per_node(&self) -> usize {
-        Plate::dofs_per_node(self)
+        each!(self, p => p.dofs_per_node())
     }
     fn nodes_per_element(&self) -> usize {
         4
     }
     fn num_elements(&self) -> usize {
-        match self {
-            Plate::TwoSurface(p) => p.num_elements(),
-            Plate::ThreeSurface(p) => p.num_elements(),
-        }
+        each!(self, p => p.num_elements())
     }
     fn element_nodes(&self, e: usize) -> &[usize] {
-        match self {
-            Plate::TwoSurface(p) => p.element_nodes(e),
-            Plate::ThreeSurface(p) => p.element_nodes(e),
-        }
+        each!(self, p => p.element_nodes(e))
     }
     fn has_preconditioner(&self) -> bool {
-        match self {
-            Plate::TwoSurface(p) => p.has_preconditioner(),
-            Plate::ThreeSurface(p) => p.has_preconditioner(),
-        }
+        each!(self, p => p.has_preconditioner())
     }
     fn new_workspace(&self) -> PlateWs {
         match self {
             Plate::TwoSurface(p) => PlateWs::TwoSurface(p.new_workspace()),
             Plate::ThreeSurface(p) => PlateWs::ThreeSurface(p.new_workspace()),
+            Plate::FourSurface(p) => PlateWs::FourSurface(p.new_workspace()),
+            Plate::FiveSurface(p) => PlateWs::FiveSurface(p.new_workspace()),
         }
     }
     fn evaluate(&self, e: usize, u: &[f64], ws: &mut PlateWs, out: &mut LocalSystem, with_tangent: bool) {
         match (self, ws) {
             (Plate::TwoSurface(p), PlateWs::TwoSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
             (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
+            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
+            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
             _ => unreachable!("a workspace is made by its own plate"),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layouts_place_faces_first_and_interpolate_the_mid_plane() {
+        let two = Layout::two_surface();
+        assert_eq!((two.dofs_per_node, two.face_dof(Face::Top, 2, 1)), (6, 16));
+        assert_eq!(two.mid_terms(1, 2).collect::<Vec<_>>(), vec![(8, 0.5), (11, 0.5)]);
+        let three = Layout::new(3);
+        assert_eq!((three.dofs_per_node, three.face_dof(Face::Top, 2, 1)), (9, 22));
+        assert_eq!(three.mid_terms(1, 2).collect::<Vec<_>>(), vec![(9 + 6 + 2, 1.0)]);
+        assert_eq!(three.fibre_components(&[2, 5]), vec![2, 5, 8]);
+        assert_eq!(three.fibre_components(&[2]), vec![2]);
+        let four = Layout::new(4);
+        assert_eq!(four.fibre_components(&[0, 3]), vec![0, 3, 6, 9]);
+        // the mid-plane of four surfaces at zeta = -1, 1, -1/3, 1/3: a field linear in zeta is
+        // interpolated exactly, so its mid value is the faces' mean
+        let u: Vec<f64> = (0..12).map(|d| [-1.0, 1.0, -1.0 / 3.0, 1.0 / 3.0][d / 3] * 2.0 + 5.0).collect();
+        assert!((four.mid_displacement(&u, 0)[1] - 5.0).abs() < 1e-14);
+        assert_eq!(four.zeta_of_component(7), -1.0 / 3.0);
     }
 }

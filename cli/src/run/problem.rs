@@ -429,21 +429,31 @@ pub struct PlateSpec {
     /// How S_33 enters the in-plane law: "dropped" (default, b_ab33 = 0) or "mean".
     #[serde(default)]
     pub normal_stress: stamp_elements::NormalStress,
-    /// The plate model: "two-surface" (default, the paper's) or "three-surface".
+    /// Surfaces through the thickness whose displacements are the unknowns: 2 (default, the
+    /// paper's plate) to 5.
     #[serde(default)]
-    pub model: PlateModelSpec,
+    pub surfaces: Surfaces,
 }
 
-/// `[plate] model`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum PlateModelSpec {
-    /// The paper's plate: the two face planes' displacements (six per node), linear through the
-    /// thickness.
-    #[default]
-    TwoSurface,
-    /// Faces and mid-plane (nine per node), quadratic through the thickness, the full 3D law.
-    ThreeSurface,
+/// `[plate] surfaces`: an integer from 2 to 5.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Surfaces(pub usize);
+impl Default for Surfaces {
+    fn default() -> Self {
+        Surfaces(2)
+    }
+}
+impl<'de> Deserialize<'de> for Surfaces {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let v = i64::deserialize(d)?;
+        if (2..=5).contains(&v) {
+            Ok(Surfaces(v as usize))
+        } else {
+            Err(D::Error::custom(format!(
+                "{v}: expected 2 (the paper's plate: the two faces, displacement linear through the thickness) to 5 (faces and inner surfaces, displacement of degree surfaces - 1 through the thickness, the 3D law)"
+            )))
+        }
+    }
 }
 
 #[derive(Debug, Deserialize)]

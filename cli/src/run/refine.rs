@@ -99,7 +99,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     }
     // every refined model must fit before anything is solved
     let sizes = stamp::mesh_refine::refined_sizes(&setup.mesh.mesh, levels);
-    check_levels_fit(&sizes, levels, super::memory::dofs_per_node(p.spec.plate.get_ref().model), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
+    check_levels_fit(&sizes, levels, super::memory::dofs_per_node(p.spec.plate.get_ref().surfaces), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
     let units = Units::new(p.spec.units.as_ref());
     let force_driven: Vec<bool> = p.spec.punch.iter().map(|s| s.get_ref().force.is_some()).collect();

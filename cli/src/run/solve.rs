@@ -82,8 +82,8 @@ struct Summary {
     nodes: usize,
     cells: usize,
     equations: usize,
-    /// `[plate] model`: "two-surface" or "three-surface".
-    plate_model: String,
+    /// `[plate] surfaces`: 2 (the paper's plate) to 5.
+    surfaces: usize,
     thickness: f64,
     delta_minus: f64,
     delta_plus: f64,
@@ -274,7 +274,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         nodes: mesh.mesh.num_nodes(),
         cells: mesh.mesh.num_cells(),
         equations: model.dofs.num_equations(),
-        plate_model: model.element.name().into(),
+        surfaces: model.element.surfaces(),
         thickness: section.thickness(),
         delta_minus: section.delta_minus,
         delta_plus: section.delta_plus,
