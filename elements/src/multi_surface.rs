@@ -41,7 +41,10 @@ use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section};
 use crate::plate::Kinematics;
 use crate::strain::{Affine, Sample};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
 use stamp::element::{Element, LocalSystem};
+use stamp::linalg::vector_state::clean_upper_vector_state;
 use stamp::mesh::QuadMesh;
 use stamp::{Result, StampError};
 
@@ -441,19 +444,13 @@ impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePla
         if !with_tangent {
             return;
         }
-        // material stiffness: the sum over the rows of B^T (w C B)
-        let k = &mut out.tangent[..D * D];
-        for (br, cr) in b.iter().zip(cb.iter()) {
-            for i in 0..D {
-                let bi = br[i];
-                if bi != 0.0 {
-                    let row = &mut k[i * D..(i + 1) * D];
-                    for (kij, &c) in row.iter_mut().zip(cr) {
-                        *kij += bi * c;
-                    }
-                }
-            }
-        }
+        // material stiffness: B^T (w C B) over all rows, one D x rows x D product
+        let rows = b.len();
+        let bm = MatRef::from_row_major_slice(b.as_flattened(), rows, D);
+        let cbm = MatRef::from_row_major_slice(cb.as_flattened(), rows, D);
+        let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..D * D], D, D);
+        matmul(k, Accum::Add, bm.transpose(), cbm, 1.0, Par::Seq);
+        clean_upper_vector_state();
         // geometric stiffness: sum_s mu_s scale_s (a b^T + b a^T) (x) I3
         if self.kinematics == Kinematics::Nonlinear {
             let mut x = [[0.0; P]; P];

@@ -4,6 +4,7 @@
     cargo build --release -p stamp-cli
     /usr/bin/python3 verification/3d/side_by_side.py                 # the default sequences
     /usr/bin/python3 verification/3d/side_by_side.py --stamp-n 10 20 40 80 160 --getfem-n 6 8 12 16 24
+    /usr/bin/python3 verification/3d/side_by_side.py --stamp-surfaces 4 --stamp-n 20 40 80 160 --getfem-n 12 16 24 32
 
 Needs GetFEM for the Debian Python (apt-get install -y python3-getfem). Not part of the test suite.
 
@@ -34,10 +35,13 @@ TOML = os.path.join(REPO, "meshes", "sphere-ss-displacement.toml")
 SIDE = 20.0
 
 
-def run_stamp(exe, n, workdir, extra=""):
-    """Run stamp on an n x n quarter mesh; return (wall time, force at travel 0.9)."""
+def run_stamp(exe, n, workdir, extra="", surfaces=2):
+    """Run stamp on an n x n quarter mesh with `surfaces` surfaces through the thickness ([plate]
+    surfaces); return (wall time, force at travel 0.9, unknowns)."""
     text = open(TOML).read()
     text = text.replace("n = [10, 10]", "n = [%d, %d]" % (n, n)).replace("plot = true", "plot = false")
+    if surfaces != 2:
+        extra = (extra + "\n" if extra else "") + "surfaces = %d" % surfaces
     if extra:
         text = text.replace("nu = 0.3\n", "nu = 0.3\n" + extra + "\n", 1)
     path = os.path.join(workdir, "stamp_n%d.toml" % n)
@@ -51,7 +55,7 @@ def run_stamp(exe, n, workdir, extra=""):
     last = rows[-1]
     if abs(float(last["sphere_travel"]) - 0.9) > 1e-9:
         sys.exit("stamp on n = %d stopped at travel %s" % (n, last["sphere_travel"]))
-    return wall, float(last["sphere_force"]), (n + 1) ** 2 * 6
+    return wall, float(last["sphere_force"]), (n + 1) ** 2 * 3 * surfaces
 
 
 def run_getfem(n, nz, penalty):
@@ -112,6 +116,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--stamp", default=os.path.join(REPO, "target", "release", "stamp"))
     ap.add_argument("--stamp-n", type=int, nargs="+", default=[10, 20, 40, 80])
+    ap.add_argument("--stamp-surfaces", type=int, default=2, help="[plate] surfaces of stamp's runs (2: the paper's plate)")
     ap.add_argument("--getfem-n", type=int, nargs="+", default=[6, 8, 12, 16])
     ap.add_argument("--nz", type=int, default=2)
     ap.add_argument("--penalty", type=float, default=1e6)
@@ -120,7 +125,7 @@ def main():
     work = tempfile.mkdtemp(prefix="side_by_side_")
     st = []
     for n in a.stamp_n:
-        w, f, u = run_stamp(a.stamp, n, work)
+        w, f, u = run_stamp(a.stamp, n, work, surfaces=a.stamp_surfaces)
         st.append((n, w, f, u))
         print("stamp  n = %4d: %7d unknowns, %8.2f s, force %.4f" % (n, u, w, f), flush=True)
     gf = []

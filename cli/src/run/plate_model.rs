@@ -58,9 +58,6 @@ impl Plate {
     pub fn surfaces(&self) -> usize {
         Element::dofs_per_node(self) / 3
     }
-    pub fn kinematics(&self) -> Kinematics {
-        each!(self, p => p.kinematics())
-    }
     /// The resultants at the centre of element `e` of a plate of more than two surfaces, at the
     /// local dofs `v`; None for the paper's plate (its resultants come from its own face
     /// resultants).
