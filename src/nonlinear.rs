@@ -64,6 +64,13 @@ pub trait NonlinearProblem {
     fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
         false
     }
+    /// Update the multipliers of the problem's constraints (augmented Lagrangian) at the iterate
+    /// of the last evaluation, inside Newton, when they are not converged yet; true when anything
+    /// changed (the residual must then be evaluated again). Called once the active set stopped
+    /// changing and |R| is small ([`NewtonSettings::multiplier_tol`]).
+    fn update_multipliers(&mut self) -> bool {
+        false
+    }
     /// Save the history-dependent state (contact) of the last converged step.
     fn checkpoint(&mut self) {}
     /// Go back to the last checkpoint (after a failed step).
@@ -134,6 +141,17 @@ pub struct NewtonSettings {
     /// Once |R| <= chord_tol * force scale (with an unchanged active set), correct with the
     /// factorisation of the last iterate instead of a new tangent (a chord step); 0: never.
     pub chord_tol: f64,
+    /// Once |R| <= multiplier_tol * force scale with an unchanged active set, the problem's
+    /// augmented-Lagrangian multipliers are updated inside Newton
+    /// ([`NonlinearProblem::update_multipliers`]) and the iterations go on from the same iterate,
+    /// instead of after Newton converged, with a re-solve of the step
+    /// ([`NonlinearProblem::end_step`], still asked at the end); 0: never. The update moves the
+    /// solution by the penetration the penalty left, a small perturbation the next one or two
+    /// Newton iterations absorb, while a re-solve costs its own convergence down to round-off:
+    /// measured on `stamp bench --problem sphere-displacement` (2026-11-24), with the multipliers
+    /// reset at each load step (`ContactPair::start_step`), 49 / 57 / 54 Newton iterations at
+    /// n = 10 / 20 / 40 became 37 / 40 / 49 (1e-2 and 1e-3 alike, 1e-4 38 / 41 / 49).
+    pub multiplier_tol: f64,
 }
 
 /// Iterations in a row with a changing active set that count as cycling.
@@ -161,6 +179,7 @@ impl Default for NewtonSettings {
             forcing: 1e-5,
             cycling_after: 0,
             chord_tol: 1e-6,
+            multiplier_tol: 1e-3,
         }
     }
 }
@@ -197,7 +216,7 @@ impl NewtonSettings {
         if self.rel_tol > 0.0 && self.rel_tol < 1e-16 {
             return bad(format!("rel_tol {:e} is below round-off; the smallest allowed is 1e-16", self.rel_tol));
         }
-        for (name, v) in [("floor_tol", self.floor_tol), ("disp_tol", self.disp_tol), ("loose_tol", self.loose_tol), ("energy_tol", self.energy_tol), ("forcing", self.forcing), ("chord_tol", self.chord_tol)] {
+        for (name, v) in [("floor_tol", self.floor_tol), ("disp_tol", self.disp_tol), ("loose_tol", self.loose_tol), ("energy_tol", self.energy_tol), ("forcing", self.forcing), ("chord_tol", self.chord_tol), ("multiplier_tol", self.multiplier_tol)] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(format!("{name} must be a finite number >= 0, got {v:e}"));
             }
@@ -289,10 +308,24 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         let mut last_chord = false;
         let mut chords = 0usize;
         for it in 0..=s.max_iterations {
-            let (ev, with_tangent) = match known.take() {
+            let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
                 None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true),
             };
+            // augmented Lagrangian inside Newton: once the active set stopped changing and |R| is
+            // small, the multipliers are updated here and Newton goes on from this iterate (the
+            // update moves the solution a little; the last iterations converge both). The
+            // residual evaluated again replaces this one: no iteration is counted for it.
+            if s.multiplier_tol > 0.0 && ev.active_changes == 0 && ev.residual_norm <= s.multiplier_tol * ev.force_scale && p.update_multipliers() {
+                ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?;
+                with_tangent = true;
+                if debug {
+                    eprintln!("  multipliers updated: |R|={:.3e} changes={}", ev.residual_norm, ev.active_changes);
+                }
+                last_energy = f64::INFINITY;
+                first_energy = f64::NAN;
+                last_correction = f64::INFINITY;
+            }
             // the tolerance of this iterate (that of the last one when the force scale is not a number)
             let tol = if ev.force_scale.is_finite() { s.rel_tol * ev.force_scale + s.abs_tol } else { *last_tol };
             *last_tol = tol;
