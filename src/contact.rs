@@ -820,6 +820,26 @@ mod entry_tests {
     }
 
     #[test]
+    fn a_load_step_starts_from_zero_multipliers_unless_asked_to_keep_them() {
+        let mut p = pair(0.5);
+        evaluate(&mut p, [1.0, 0.0, 0.0, 0.0]);
+        let penetration = p.augment();
+        assert!((penetration - 0.999).abs() < 1e-12, "{penetration}");
+        assert!(p.lambda_bar[0] < 0.0);
+        p.start_step();
+        assert_eq!(p.lambda_bar, vec![0.0; 4]);
+        // kept: the last update's multipliers carry over
+        let mut p = pair(0.5);
+        p.reset_multipliers = false;
+        evaluate(&mut p, [1.0, 0.0, 0.0, 0.0]);
+        p.augment();
+        let kept = p.lambda_bar.clone();
+        p.start_step();
+        assert_eq!(p.lambda_bar, kept);
+        assert!(kept[0] < 0.0);
+    }
+
+    #[test]
     fn with_entry_fraction_zero_every_penetrating_point_enters_at_once() {
         let mut p = pair(0.0);
         evaluate(&mut p, [0.0; 4]);

@@ -631,11 +631,15 @@ mod tests {
         /// (as an augmented-Lagrangian update moves the contact forces).
         extra_solves: usize,
         shift: f64,
+        /// update_multipliers shifts the solution by 0.01 this many times in all (an
+        /// augmented-Lagrangian update inside Newton); |R| at each call that did.
+        multiplier_updates: usize,
+        updated_at: Vec<f64>,
     }
 
     impl Line {
         fn new() -> Self {
-            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0, extra_solves: 0, shift: 0.0 }
+            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0, extra_solves: 0, shift: 0.0, multiplier_updates: 0, updated_at: Vec::new() }
         }
     }
 
@@ -659,6 +663,14 @@ mod tests {
         }
         fn add_increment(&self, u: &mut [f64], du: &[f64]) {
             u[0] += du[0];
+        }
+        fn update_multipliers(&mut self) -> bool {
+            if self.updated_at.len() == self.multiplier_updates {
+                return false;
+            }
+            self.updated_at.push(self.residual[0].abs());
+            self.shift += 0.01;
+            true
         }
         fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
             self.restarts += 1;
@@ -737,6 +749,35 @@ mod tests {
         assert!(r.iterations > r.residual_history.len() - 1, "the last solve's history only: {r:?}");
         assert_eq!(r.iterations, summary.newton_iterations);
         assert!((u[0] - 0.27).abs() < 1e-12, "{}", u[0]);
+    }
+
+    #[test]
+    fn multipliers_updated_inside_newton_need_no_re_solve() {
+        let mut p = Line { multiplier_updates: 3, ..Line::new() };
+        let mut u = [0.0];
+        let mut reports = Vec::new();
+        let summary = NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |r, _, _| reports.push(r.clone())).unwrap();
+        // the three updates moved the solution, inside one solve: end_step was asked once
+        assert_eq!(p.updated_at.len(), 3);
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        assert_eq!(p.restarts, 1, "no re-solve of the step");
+        // only once |R| <= multiplier_tol * force scale (1): never at the first residual 0.25
+        let tol = NewtonSettings::default().multiplier_tol;
+        assert!(p.updated_at.iter().all(|&r| r <= tol), "{:?}", p.updated_at);
+        // each update costs one Newton iteration here (a linear problem), counted once
+        assert_eq!(reports[0].iterations, 4);
+        assert_eq!(summary.newton_iterations, 4);
+        // multiplier_tol = 0: no update inside Newton, the same answer through end_step's re-solves
+        let mut p = Line { extra_solves: 3, multiplier_updates: 3, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { multiplier_tol: 0.0, ..settings() };
+        NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap();
+        assert!(p.updated_at.is_empty());
+        assert_eq!(p.restarts, 4);
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        // a negative or NaN tolerance is refused
+        let e = NewtonSettings { multiplier_tol: f64::NAN, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("multiplier_tol"), "{e}");
     }
 
     #[test]
