@@ -269,16 +269,6 @@ pub struct ContactPair {
     pub step_start_entry_fraction: Option<f64>,
     /// No evaluation with a tangent yet in this load step.
     step_start: bool,
-    /// Start every load step from lambda_bar = 0 (the plain penalty), the augmented-Lagrangian
-    /// updates of the step building it up again (default). The multipliers of the last step
-    /// belong to its contact zone, and the zone moves: where the plate lifts off (the centre of
-    /// a flat sphere's zone between t = 0.2 and 0.8), they hold points on the punch with a gap
-    /// (lambda = lambda_bar + eps Psi < 0 with Psi > 0), which the next update must release,
-    /// changing the active set again. False: lambda_bar carries over from step to step.
-    /// Measured on `stamp bench --problem sphere-displacement` (2026-11-24, with the multipliers
-    /// updated inside Newton): 40 / 49 / 51 Newton iterations at n = 10 / 20 / 40 carried over,
-    /// 37 / 40 / 49 reset.
-    pub reset_multipliers: bool,
     /// The point kinematics of the last evaluation (scratch, reused).
     kinematics_scratch: Vec<(f64, Vector3<f64>, f64, Option<Vector3<f64>>)>,
 }
@@ -320,19 +310,14 @@ impl ContactPair {
             first_touch_fraction: Some(FIRST_TOUCH_FRACTION),
             step_start_entry_fraction: Some(STEP_START_ENTRY_FRACTION),
             step_start: true,
-            reset_multipliers: true,
             kinematics_scratch: Vec::new(),
         }
     }
 
-    /// Forget the cycling history (at the start of a load step) and, with
-    /// [`reset_multipliers`](Self::reset_multipliers), the augmented-Lagrangian multipliers.
+    /// Forget the cycling history (at the start of a load step).
     pub fn start_step(&mut self) {
         self.flips.fill(0);
         self.frozen.fill(false);
-        if self.reset_multipliers {
-            self.lambda_bar.fill(0.0);
-        }
         self.step_start = true;
         self.lambda_scale = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
     }
@@ -817,26 +802,6 @@ mod entry_tests {
         assert_eq!((changes, active), (3, vec![true, false, false, true]));
         // the next iteration uses entry_fraction (half of -5.99): both enter
         assert_eq!(evaluate(&mut p, [1.0, 0.6, 0.4, 1e-3]), (2, vec![true; 4]));
-    }
-
-    #[test]
-    fn a_load_step_starts_from_zero_multipliers_unless_asked_to_keep_them() {
-        let mut p = pair(0.5);
-        evaluate(&mut p, [1.0, 0.0, 0.0, 0.0]);
-        let penetration = p.augment();
-        assert!((penetration - 0.999).abs() < 1e-12, "{penetration}");
-        assert!(p.lambda_bar[0] < 0.0);
-        p.start_step();
-        assert_eq!(p.lambda_bar, vec![0.0; 4]);
-        // kept: the last update's multipliers carry over
-        let mut p = pair(0.5);
-        p.reset_multipliers = false;
-        evaluate(&mut p, [1.0, 0.0, 0.0, 0.0]);
-        p.augment();
-        let kept = p.lambda_bar.clone();
-        p.start_step();
-        assert_eq!(p.lambda_bar, kept);
-        assert!(kept[0] < 0.0);
     }
 
     #[test]

@@ -148,9 +148,9 @@ pub struct NewtonSettings {
     /// ([`NonlinearProblem::end_step`], still asked at the end); 0: never. The update moves the
     /// solution by the penetration the penalty left, a small perturbation the next one or two
     /// Newton iterations absorb, while a re-solve costs its own convergence down to round-off:
-    /// measured on `stamp bench --problem sphere-displacement` (2026-11-24), with the multipliers
-    /// reset at each load step (`ContactPair::start_step`), 49 / 57 / 54 Newton iterations at
-    /// n = 10 / 20 / 40 became 37 / 40 / 49 (1e-2 and 1e-3 alike, 1e-4 38 / 41 / 49).
+    /// measured on `stamp bench --problem sphere-displacement` (2026-11-24), 49 / 57 / 54 Newton
+    /// iterations at n = 10 / 20 / 40 became 40 / 49 / 51 (1e-5: 40 / 51 / 52), the reactions of
+    /// every step the same to 2e-8 relative (docs/performance.md).
     pub multiplier_tol: f64,
 }
 
