@@ -96,6 +96,9 @@ pub struct NewtonSettings {
     /// that of the first (the classical energy criterion; immune to round-off in stiff modes such
     /// as the thickness stretch of a very thin plate, whose conditioning grows like (l/h)^4).
     pub energy_tol: f64,
+    /// Most Newton iterations of one solve; a multiplier update inside Newton
+    /// ([`multiplier_tol`](Self::multiplier_tol)) starts the count afresh, as a re-solve after
+    /// [`NonlinearProblem::end_step`] does (at most `max_restarts` such updates per solve).
     pub max_iterations: usize,
     /// Most halvings of the Newton correction in the line search (0: plain Newton).
     pub line_search_steps: usize,
@@ -105,7 +108,8 @@ pub struct NewtonSettings {
     pub max_increment: f64,
     /// Smallest load increment before giving up.
     pub min_increment: f64,
-    /// The increment grows by this factor after a step that took at most `easy_iterations`.
+    /// The increment grows by this factor after a step whose last solve took at most
+    /// `easy_iterations` (counted from the last multiplier update inside Newton, if any).
     pub growth: f64,
     pub easy_iterations: usize,
     /// Most cut-backs in a row.
@@ -282,12 +286,13 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         NewtonRaphson { settings, linear, on_iteration: None, stop: None }
     }
 
-    /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history,
-    /// or the reason for failure.
+    /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
+    /// and the iterations before the last multiplier update inside Newton (0 without one), or the
+    /// reason for failure.
     /// `peak_energy` is the largest first-correction energy of the path's converged steps:
     /// the energy criterion compares with it too, because a step that starts from a good predictor
     /// has a first correction already at round-off.
-    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<(Vec<f64>, usize), (String, f64, f64)> {
         let s = &self.settings;
         let mut history = Vec::new();
         let mut du = vec![0.0; p.num_equations()];
@@ -307,7 +312,11 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         // the last correction was a chord step; chord steps taken (for the debug output)
         let mut last_chord = false;
         let mut chords = 0usize;
-        for it in 0..=s.max_iterations {
+        // the iteration from which the budget of max_iterations counts: the last multiplier
+        // update inside Newton (a re-solve of the step after end_step had a budget of its own)
+        let mut budget_start = 0;
+        let mut updates = 0;
+        for it in 0.. {
             let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
                 None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true),
@@ -316,7 +325,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             // small, the multipliers are updated here and Newton goes on from this iterate (the
             // update moves the solution a little; the last iterations converge both). The
             // residual evaluated again replaces this one: no iteration is counted for it.
-            if s.multiplier_tol > 0.0 && ev.active_changes == 0 && ev.residual_norm <= s.multiplier_tol * ev.force_scale && p.update_multipliers() {
+            if s.multiplier_tol > 0.0 && updates < s.max_restarts && ev.active_changes == 0 && ev.residual_norm <= s.multiplier_tol * ev.force_scale && p.update_multipliers() {
+                updates += 1;
+                budget_start = it;
                 ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?;
                 with_tangent = true;
                 if debug {
@@ -367,9 +378,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                     if first_energy.is_finite() {
                         *peak_energy = peak_energy.max(first_energy);
                     }
-                    return Ok(history);
+                    return Ok((history, budget_start));
                 }
-                if p.update_active_set() > 0 && it < s.max_iterations {
+                if p.update_active_set() > 0 && it - budget_start < s.max_iterations {
                     // converged on the old set: re-solve with the new one (whose tangent is new)
                     factored = false;
                     last_energy = f64::INFINITY;
@@ -389,7 +400,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                     return Err((format!("the active set changed at each of the last {changing} iterations without reducing |R| (cycling)"), ev.residual_norm, tol));
                 }
             }
-            if it == s.max_iterations {
+            if it - budget_start == s.max_iterations {
                 let why = if ev.active_changes > 0 { " (the active set kept changing)" } else { "" };
                 return Err((format!("no convergence in {} iterations{why}", s.max_iterations), ev.residual_norm, tol));
             }
@@ -523,7 +534,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 let mut restart_iterations = 0;
                 let result = loop {
                     match self.iterate(p, &mut trial, step_t, &mut peak_energy, &mut last_tol) {
-                        Ok(h) => {
+                        Ok((h, before_update)) => {
                             if p.end_step(&trial, step_t) {
                                 // the problem's own condition (the augmented Lagrangian's penetration
                                 // tolerance) does not hold yet: solve again, but never call the step
@@ -541,16 +552,18 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                                     last_tol,
                                 ));
                             }
-                            break Ok(h);
+                            break Ok((h, before_update));
                         }
                         Err(e) => break Err(e),
                     }
                 };
                 match result {
-                    Ok(history) => {
-                        // the last solve's iterations decide the growth of the increment (as before
-                        // re-solves were counted), the report counts them all
+                    Ok((history, before_update)) => {
+                        // the iterations since the last multiplier update, in the last solve, decide
+                        // the growth of the increment (as before re-solves and updates inside
+                        // Newton were counted), the report counts them all
                         let iterations = history.len() - 1;
+                        let last_round = iterations - before_update;
                         summary.newton_iterations += iterations;
                         summary.steps += 1;
                         match previous.as_mut() {
@@ -579,7 +592,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             return Err(StampError::Problem(format!("stopped on request after load step {} (load factor {t:.6e})", summary.steps)));
                         }
                         cutbacks_in_row = 0;
-                        if iterations <= self.settings.easy_iterations {
+                        if last_round <= self.settings.easy_iterations {
                             dt = (dt * self.settings.growth).min(self.settings.max_increment);
                         }
                     }
@@ -749,6 +762,27 @@ mod tests {
         assert!(r.iterations > r.residual_history.len() - 1, "the last solve's history only: {r:?}");
         assert_eq!(r.iterations, summary.newton_iterations);
         assert!((u[0] - 0.27).abs() < 1e-12, "{}", u[0]);
+    }
+
+    #[test]
+    fn each_multiplier_update_inside_newton_gets_its_own_iteration_budget() {
+        // one iteration per solve: each of the three updates needs one more, as a re-solve would
+        let mut p = Line { multiplier_updates: 3, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_iterations: 1, ..settings() };
+        let summary = NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap();
+        assert_eq!(p.updated_at.len(), 3);
+        assert_eq!(summary.newton_iterations, 4);
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        // at most max_restarts updates inside one solve: the rest through end_step's re-solves
+        let mut p = Line { multiplier_updates: 3, extra_solves: 1, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_restarts: 2, ..settings() };
+        NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap();
+        // two updates in the first solve, end_step's shift and a re-solve, one more update in it
+        assert_eq!(p.updated_at.len(), 3);
+        assert_eq!(p.restarts, 2);
+        assert!((u[0] - 0.29).abs() < 1e-12, "{}", u[0]);
     }
 
     #[test]
