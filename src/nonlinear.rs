@@ -98,7 +98,7 @@ pub struct NewtonSettings {
     pub energy_tol: f64,
     /// Most Newton iterations of one solve; a multiplier update inside Newton
     /// ([`multiplier_tol`](Self::multiplier_tol)) starts the count afresh, as a re-solve after
-    /// [`NonlinearProblem::end_step`] does (at most `max_restarts` such updates per solve).
+    /// [`NonlinearProblem::end_step`] does.
     pub max_iterations: usize,
     /// Most halvings of the Newton correction in the line search (0: plain Newton).
     pub line_search_steps: usize,
@@ -114,7 +114,8 @@ pub struct NewtonSettings {
     pub easy_iterations: usize,
     /// Most cut-backs in a row.
     pub max_cutbacks: usize,
-    /// Most re-solves of one step requested by the problem (augmented Lagrangian).
+    /// Most multiplier updates of one load step (augmented Lagrangian): inside Newton
+    /// ([`multiplier_tol`](Self::multiplier_tol)) and by re-solves the problem asks for, together.
     pub max_restarts: usize,
     /// Start each load step from the secant extrapolation of the last two converged states,
     /// u_n + (t - t_n)/(t_n - t_{n-1}) (u_n - u_{n-1}), instead of u_n: the body follows a moving
@@ -289,10 +290,12 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
     /// and the iterations before the last multiplier update inside Newton (0 without one), or the
     /// reason for failure.
+    /// `updates` counts the multiplier updates of the load step, inside Newton and by re-solves
+    /// (at most `max_restarts` in all).
     /// `peak_energy` is the largest first-correction energy of the path's converged steps:
     /// the energy criterion compares with it too, because a step that starts from a good predictor
     /// has a first correction already at round-off.
-    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<(Vec<f64>, usize), (String, f64, f64)> {
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, updates: &mut usize, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<(Vec<f64>, usize), (String, f64, f64)> {
         let s = &self.settings;
         let mut history = Vec::new();
         let mut du = vec![0.0; p.num_equations()];
@@ -315,7 +318,6 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         // the iteration from which the budget of max_iterations counts: the last multiplier
         // update inside Newton (a re-solve of the step after end_step had a budget of its own)
         let mut budget_start = 0;
-        let mut updates = 0;
         for it in 0.. {
             let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
@@ -325,8 +327,8 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             // small, the multipliers are updated here and Newton goes on from this iterate (the
             // update moves the solution a little; the last iterations converge both). The
             // residual evaluated again replaces this one: no iteration is counted for it.
-            if s.multiplier_tol > 0.0 && updates < s.max_restarts && ev.active_changes == 0 && ev.residual_norm <= s.multiplier_tol * ev.force_scale && p.update_multipliers() {
-                updates += 1;
+            if s.multiplier_tol > 0.0 && *updates < s.max_restarts && ev.active_changes == 0 && ev.residual_norm <= s.multiplier_tol * ev.force_scale && p.update_multipliers() {
+                *updates += 1;
                 budget_start = it;
                 ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?;
                 with_tangent = true;
@@ -529,18 +531,19 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 }
                 p.apply_prescribed(&mut trial, step_t);
                 p.start_step();
-                let mut restarts = 0;
+                // multiplier updates of this attempt, inside Newton and by re-solves
+                let mut updates = 0;
                 // iterations of the re-solves of this step before the last one
                 let mut restart_iterations = 0;
                 let result = loop {
-                    match self.iterate(p, &mut trial, step_t, &mut peak_energy, &mut last_tol) {
+                    match self.iterate(p, &mut trial, step_t, &mut updates, &mut peak_energy, &mut last_tol) {
                         Ok((h, before_update)) => {
                             if p.end_step(&trial, step_t) {
                                 // the problem's own condition (the augmented Lagrangian's penetration
                                 // tolerance) does not hold yet: solve again, but never call the step
                                 // converged while it does not hold
-                                if restarts < self.settings.max_restarts {
-                                    restarts += 1;
+                                if updates < self.settings.max_restarts {
+                                    updates += 1;
                                     summary.newton_iterations += h.len() - 1;
                                     restart_iterations += h.len() - 1;
                                     continue;
@@ -774,15 +777,26 @@ mod tests {
         assert_eq!(p.updated_at.len(), 3);
         assert_eq!(summary.newton_iterations, 4);
         assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
-        // at most max_restarts updates inside one solve: the rest through end_step's re-solves
-        let mut p = Line { multiplier_updates: 3, extra_solves: 1, ..Line::new() };
+        // max_restarts bounds the updates inside Newton and the re-solves together: two inside,
+        // then end_step's shift and a re-solve make three
+        let mut p = Line { multiplier_updates: 2, extra_solves: 1, ..Line::new() };
         let mut u = [0.0];
-        let s = NewtonSettings { max_restarts: 2, ..settings() };
+        let s = NewtonSettings { max_restarts: 3, ..settings() };
         NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap();
-        // two updates in the first solve, end_step's shift and a re-solve, one more update in it
-        assert_eq!(p.updated_at.len(), 3);
-        assert_eq!(p.restarts, 2);
-        assert!((u[0] - 0.29).abs() < 1e-12, "{}", u[0]);
+        assert_eq!((p.updated_at.len(), p.restarts), (2, 2));
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        // with 2 allowed, the re-solve is refused: the step fails with the count
+        let mut p = Line { multiplier_updates: 2, extra_solves: 1, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_restarts: 2, max_cutbacks: 0, ..settings() };
+        let e = NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap_err().to_string();
+        assert!(e.contains("still violated") && e.contains("after 2 augmented-Lagrangian updates"), "{e}");
+        // a solve that never meets its end condition stops at max_restarts updates in all
+        let mut p = Line { multiplier_updates: usize::MAX, never_satisfied: true, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_restarts: 5, max_cutbacks: 0, ..settings() };
+        assert!(NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).is_err());
+        assert_eq!(p.updated_at.len(), 5);
     }
 
     #[test]
