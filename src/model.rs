@@ -198,6 +198,25 @@ impl<E: Element> Model<E> {
     }
 }
 
+impl<E: Element> Model<E> {
+    /// The augmented-Lagrangian update (lambda_bar <- lambda, [`ContactPair::augment`]) of every
+    /// punch whose constraints at the last evaluation are violated beyond
+    /// [`augmented_tolerance`](Self::augmented_tolerance): a penetration above it, or an active
+    /// point whose multiplier lambda_bar holds it off the punch (a gap) by more. True when any was
+    /// updated (the residual changed); false without a tolerance.
+    fn augment_violated(&mut self) -> bool {
+        let Some(tol) = self.augmented_tolerance else { return false };
+        let mut again = false;
+        for c in self.contacts.iter_mut() {
+            if c.constraint_violation() > tol {
+                c.augment();
+                again = true;
+            }
+        }
+        again
+    }
+}
+
 impl<E: Element> NonlinearProblem for Model<E> {
     fn num_dofs(&self) -> usize {
         self.dofs.num_dofs() + self.num_drives()
@@ -341,18 +360,13 @@ impl<E: Element> NonlinearProblem for Model<E> {
             c.start_step();
         }
     }
+    /// The augmented-Lagrangian update of [`end_step`](Self::end_step), at the last evaluation's
+    /// iterate (Newton calls it before it converged, see [`crate::nonlinear::NewtonSettings::multiplier_tol`]).
+    fn update_multipliers(&mut self) -> bool {
+        self.augment_violated()
+    }
     fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
-        let Some(tol) = self.augmented_tolerance else { return false };
-        let mut again = false;
-        for c in self.contacts.iter_mut() {
-            // both ways: a penetration above the tolerance, or an active point whose multiplier
-            // lambda_bar holds it off the punch (a gap) by more than the tolerance
-            if c.constraint_violation() > tol {
-                c.augment();
-                again = true;
-            }
-        }
-        again
+        self.augment_violated()
     }
     fn checkpoint(&mut self) {
         // called after a converged step (and once before the first): its last evaluation is the

@@ -64,6 +64,13 @@ pub trait NonlinearProblem {
     fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
         false
     }
+    /// Update the multipliers of the problem's constraints (augmented Lagrangian) at the iterate
+    /// of the last evaluation, inside Newton, when they are not converged yet; true when anything
+    /// changed (the residual must then be evaluated again). Called once the active set stopped
+    /// changing and |R| is small ([`NewtonSettings::multiplier_tol`]).
+    fn update_multipliers(&mut self) -> bool {
+        false
+    }
     /// Save the history-dependent state (contact) of the last converged step.
     fn checkpoint(&mut self) {}
     /// Go back to the last checkpoint (after a failed step).
@@ -89,6 +96,9 @@ pub struct NewtonSettings {
     /// that of the first (the classical energy criterion; immune to round-off in stiff modes such
     /// as the thickness stretch of a very thin plate, whose conditioning grows like (l/h)^4).
     pub energy_tol: f64,
+    /// Most Newton iterations of one solve; a multiplier update inside Newton
+    /// ([`multiplier_tol`](Self::multiplier_tol)) starts the count afresh, as a re-solve after
+    /// [`NonlinearProblem::end_step`] does.
     pub max_iterations: usize,
     /// Most halvings of the Newton correction in the line search (0: plain Newton).
     pub line_search_steps: usize,
@@ -98,12 +108,14 @@ pub struct NewtonSettings {
     pub max_increment: f64,
     /// Smallest load increment before giving up.
     pub min_increment: f64,
-    /// The increment grows by this factor after a step that took at most `easy_iterations`.
+    /// The increment grows by this factor after a step whose last solve took at most
+    /// `easy_iterations` (counted from the last multiplier update inside Newton, if any).
     pub growth: f64,
     pub easy_iterations: usize,
     /// Most cut-backs in a row.
     pub max_cutbacks: usize,
-    /// Most re-solves of one step requested by the problem (augmented Lagrangian).
+    /// Most multiplier updates of one load step (augmented Lagrangian): inside Newton
+    /// ([`multiplier_tol`](Self::multiplier_tol)) and by re-solves the problem asks for, together.
     pub max_restarts: usize,
     /// Start each load step from the secant extrapolation of the last two converged states,
     /// u_n + (t - t_n)/(t_n - t_{n-1}) (u_n - u_{n-1}), instead of u_n: the body follows a moving
@@ -134,6 +146,17 @@ pub struct NewtonSettings {
     /// Once |R| <= chord_tol * force scale (with an unchanged active set), correct with the
     /// factorisation of the last iterate instead of a new tangent (a chord step); 0: never.
     pub chord_tol: f64,
+    /// Once |R| <= multiplier_tol * force scale with an unchanged active set, the problem's
+    /// augmented-Lagrangian multipliers are updated inside Newton
+    /// ([`NonlinearProblem::update_multipliers`]) and the iterations go on from the same iterate,
+    /// instead of after Newton converged, with a re-solve of the step
+    /// ([`NonlinearProblem::end_step`], still asked at the end); 0: never. The update moves the
+    /// solution by the penetration the penalty left, a small perturbation the next one or two
+    /// Newton iterations absorb, while a re-solve costs its own convergence down to round-off:
+    /// measured on `stamp bench --problem sphere-displacement` (2026-11-24), 49 / 57 / 54 Newton
+    /// iterations at n = 10 / 20 / 40 became 40 / 49 / 51 (1e-5: 40 / 51 / 52), the reactions of
+    /// every step the same to 2e-8 relative (docs/performance.md).
+    pub multiplier_tol: f64,
 }
 
 /// Iterations in a row with a changing active set that count as cycling.
@@ -161,6 +184,7 @@ impl Default for NewtonSettings {
             forcing: 1e-5,
             cycling_after: 0,
             chord_tol: 1e-6,
+            multiplier_tol: 1e-3,
         }
     }
 }
@@ -197,7 +221,7 @@ impl NewtonSettings {
         if self.rel_tol > 0.0 && self.rel_tol < 1e-16 {
             return bad(format!("rel_tol {:e} is below round-off; the smallest allowed is 1e-16", self.rel_tol));
         }
-        for (name, v) in [("floor_tol", self.floor_tol), ("disp_tol", self.disp_tol), ("loose_tol", self.loose_tol), ("energy_tol", self.energy_tol), ("forcing", self.forcing), ("chord_tol", self.chord_tol)] {
+        for (name, v) in [("floor_tol", self.floor_tol), ("disp_tol", self.disp_tol), ("loose_tol", self.loose_tol), ("energy_tol", self.energy_tol), ("forcing", self.forcing), ("chord_tol", self.chord_tol), ("multiplier_tol", self.multiplier_tol)] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(format!("{name} must be a finite number >= 0, got {v:e}"));
             }
@@ -263,12 +287,15 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         NewtonRaphson { settings, linear, on_iteration: None, stop: None }
     }
 
-    /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history,
-    /// or the reason for failure.
+    /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
+    /// and the iterations before the last multiplier update inside Newton (0 without one), or the
+    /// reason for failure.
+    /// `updates` counts the multiplier updates of the load step, inside Newton and by re-solves
+    /// (at most `max_restarts` in all).
     /// `peak_energy` is the largest first-correction energy of the path's converged steps:
     /// the energy criterion compares with it too, because a step that starts from a good predictor
     /// has a first correction already at round-off.
-    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<Vec<f64>, (String, f64, f64)> {
+    fn iterate<P: NonlinearProblem>(&mut self, p: &mut P, u: &mut [f64], t: f64, updates: &mut usize, peak_energy: &mut f64, last_tol: &mut f64) -> std::result::Result<(Vec<f64>, usize), (String, f64, f64)> {
         let s = &self.settings;
         let mut history = Vec::new();
         let mut du = vec![0.0; p.num_equations()];
@@ -288,11 +315,30 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         // the last correction was a chord step; chord steps taken (for the debug output)
         let mut last_chord = false;
         let mut chords = 0usize;
-        for it in 0..=s.max_iterations {
-            let (ev, with_tangent) = match known.take() {
+        // the iteration from which the budget of max_iterations counts: the last multiplier
+        // update inside Newton (a re-solve of the step after end_step had a budget of its own)
+        let mut budget_start = 0;
+        for it in 0.. {
+            let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
                 None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true),
             };
+            // augmented Lagrangian inside Newton: once the active set stopped changing and |R| is
+            // small, the multipliers are updated here and Newton goes on from this iterate (the
+            // update moves the solution a little; the last iterations converge both). The
+            // residual evaluated again replaces this one: no iteration is counted for it.
+            if s.multiplier_tol > 0.0 && *updates < s.max_restarts && ev.active_changes == 0 && ev.residual_norm <= s.multiplier_tol * ev.force_scale && p.update_multipliers() {
+                *updates += 1;
+                budget_start = it;
+                ev = p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?;
+                with_tangent = true;
+                if debug {
+                    eprintln!("  multipliers updated: |R|={:.3e} changes={}", ev.residual_norm, ev.active_changes);
+                }
+                last_energy = f64::INFINITY;
+                first_energy = f64::NAN;
+                last_correction = f64::INFINITY;
+            }
             // the tolerance of this iterate (that of the last one when the force scale is not a number)
             let tol = if ev.force_scale.is_finite() { s.rel_tol * ev.force_scale + s.abs_tol } else { *last_tol };
             *last_tol = tol;
@@ -334,9 +380,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                     if first_energy.is_finite() {
                         *peak_energy = peak_energy.max(first_energy);
                     }
-                    return Ok(history);
+                    return Ok((history, budget_start));
                 }
-                if p.update_active_set() > 0 && it < s.max_iterations {
+                if p.update_active_set() > 0 && it - budget_start < s.max_iterations {
                     // converged on the old set: re-solve with the new one (whose tangent is new)
                     factored = false;
                     last_energy = f64::INFINITY;
@@ -356,7 +402,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                     return Err((format!("the active set changed at each of the last {changing} iterations without reducing |R| (cycling)"), ev.residual_norm, tol));
                 }
             }
-            if it == s.max_iterations {
+            if it - budget_start == s.max_iterations {
                 let why = if ev.active_changes > 0 { " (the active set kept changing)" } else { "" };
                 return Err((format!("no convergence in {} iterations{why}", s.max_iterations), ev.residual_norm, tol));
             }
@@ -485,18 +531,19 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 }
                 p.apply_prescribed(&mut trial, step_t);
                 p.start_step();
-                let mut restarts = 0;
+                // multiplier updates of this attempt, inside Newton and by re-solves
+                let mut updates = 0;
                 // iterations of the re-solves of this step before the last one
                 let mut restart_iterations = 0;
                 let result = loop {
-                    match self.iterate(p, &mut trial, step_t, &mut peak_energy, &mut last_tol) {
-                        Ok(h) => {
+                    match self.iterate(p, &mut trial, step_t, &mut updates, &mut peak_energy, &mut last_tol) {
+                        Ok((h, before_update)) => {
                             if p.end_step(&trial, step_t) {
                                 // the problem's own condition (the augmented Lagrangian's penetration
                                 // tolerance) does not hold yet: solve again, but never call the step
                                 // converged while it does not hold
-                                if restarts < self.settings.max_restarts {
-                                    restarts += 1;
+                                if updates < self.settings.max_restarts {
+                                    updates += 1;
                                     summary.newton_iterations += h.len() - 1;
                                     restart_iterations += h.len() - 1;
                                     continue;
@@ -508,16 +555,18 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                                     last_tol,
                                 ));
                             }
-                            break Ok(h);
+                            break Ok((h, before_update));
                         }
                         Err(e) => break Err(e),
                     }
                 };
                 match result {
-                    Ok(history) => {
-                        // the last solve's iterations decide the growth of the increment (as before
-                        // re-solves were counted), the report counts them all
+                    Ok((history, before_update)) => {
+                        // the iterations since the last multiplier update, in the last solve, decide
+                        // the growth of the increment (as before re-solves and updates inside
+                        // Newton were counted), the report counts them all
                         let iterations = history.len() - 1;
+                        let last_round = iterations - before_update;
                         summary.newton_iterations += iterations;
                         summary.steps += 1;
                         match previous.as_mut() {
@@ -546,7 +595,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             return Err(StampError::Problem(format!("stopped on request after load step {} (load factor {t:.6e})", summary.steps)));
                         }
                         cutbacks_in_row = 0;
-                        if iterations <= self.settings.easy_iterations {
+                        if last_round <= self.settings.easy_iterations {
                             dt = (dt * self.settings.growth).min(self.settings.max_increment);
                         }
                     }
@@ -598,11 +647,15 @@ mod tests {
         /// (as an augmented-Lagrangian update moves the contact forces).
         extra_solves: usize,
         shift: f64,
+        /// update_multipliers shifts the solution by 0.01 this many times in all (an
+        /// augmented-Lagrangian update inside Newton); |R| at each call that did.
+        multiplier_updates: usize,
+        updated_at: Vec<f64>,
     }
 
     impl Line {
         fn new() -> Self {
-            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0, extra_solves: 0, shift: 0.0 }
+            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0, extra_solves: 0, shift: 0.0, multiplier_updates: 0, updated_at: Vec::new() }
         }
     }
 
@@ -626,6 +679,14 @@ mod tests {
         }
         fn add_increment(&self, u: &mut [f64], du: &[f64]) {
             u[0] += du[0];
+        }
+        fn update_multipliers(&mut self) -> bool {
+            if self.updated_at.len() == self.multiplier_updates {
+                return false;
+            }
+            self.updated_at.push(self.residual[0].abs());
+            self.shift += 0.01;
+            true
         }
         fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
             self.restarts += 1;
@@ -704,6 +765,67 @@ mod tests {
         assert!(r.iterations > r.residual_history.len() - 1, "the last solve's history only: {r:?}");
         assert_eq!(r.iterations, summary.newton_iterations);
         assert!((u[0] - 0.27).abs() < 1e-12, "{}", u[0]);
+    }
+
+    #[test]
+    fn each_multiplier_update_inside_newton_gets_its_own_iteration_budget() {
+        // one iteration per solve: each of the three updates needs one more, as a re-solve would
+        let mut p = Line { multiplier_updates: 3, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_iterations: 1, ..settings() };
+        let summary = NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap();
+        assert_eq!(p.updated_at.len(), 3);
+        assert_eq!(summary.newton_iterations, 4);
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        // max_restarts bounds the updates inside Newton and the re-solves together: two inside,
+        // then end_step's shift and a re-solve make three
+        let mut p = Line { multiplier_updates: 2, extra_solves: 1, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_restarts: 3, ..settings() };
+        NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap();
+        assert_eq!((p.updated_at.len(), p.restarts), (2, 2));
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        // with 2 allowed, the re-solve is refused: the step fails with the count
+        let mut p = Line { multiplier_updates: 2, extra_solves: 1, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_restarts: 2, max_cutbacks: 0, ..settings() };
+        let e = NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap_err().to_string();
+        assert!(e.contains("still violated") && e.contains("after 2 augmented-Lagrangian updates"), "{e}");
+        // a solve that never meets its end condition stops at max_restarts updates in all
+        let mut p = Line { multiplier_updates: usize::MAX, never_satisfied: true, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { max_restarts: 5, max_cutbacks: 0, ..settings() };
+        assert!(NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).is_err());
+        assert_eq!(p.updated_at.len(), 5);
+    }
+
+    #[test]
+    fn multipliers_updated_inside_newton_need_no_re_solve() {
+        let mut p = Line { multiplier_updates: 3, ..Line::new() };
+        let mut u = [0.0];
+        let mut reports = Vec::new();
+        let summary = NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |r, _, _| reports.push(r.clone())).unwrap();
+        // the three updates moved the solution, inside one solve: end_step was asked once
+        assert_eq!(p.updated_at.len(), 3);
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        assert_eq!(p.restarts, 1, "no re-solve of the step");
+        // only once |R| <= multiplier_tol * force scale (1): never at the first residual 0.25
+        let tol = NewtonSettings::default().multiplier_tol;
+        assert!(p.updated_at.iter().all(|&r| r <= tol), "{:?}", p.updated_at);
+        // each update costs one Newton iteration here (a linear problem), counted once
+        assert_eq!(reports[0].iterations, 4);
+        assert_eq!(summary.newton_iterations, 4);
+        // multiplier_tol = 0: no update inside Newton, the same answer through end_step's re-solves
+        let mut p = Line { extra_solves: 3, multiplier_updates: 3, ..Line::new() };
+        let mut u = [0.0];
+        let s = NewtonSettings { multiplier_tol: 0.0, ..settings() };
+        NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[0.25], &mut |_, _, _| {}).unwrap();
+        assert!(p.updated_at.is_empty());
+        assert_eq!(p.restarts, 4);
+        assert!((u[0] - 0.28).abs() < 1e-12, "{}", u[0]);
+        // a negative or NaN tolerance is refused
+        let e = NewtonSettings { multiplier_tol: f64::NAN, ..settings() }.validate().unwrap_err().to_string();
+        assert!(e.contains("multiplier_tol"), "{e}");
     }
 
     #[test]
