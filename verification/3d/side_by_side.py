@@ -121,6 +121,8 @@ def main():
     ap.add_argument("--nz", type=int, default=2)
     ap.add_argument("--penalty", type=float, default=1e6)
     a = ap.parse_args()
+    if len(a.stamp_n) < 3 or len(a.getfem_n) < 3:
+        sys.exit("--stamp-n and --getfem-n need three meshes or more each (the limits are extrapolated from the three finest)")
 
     work = tempfile.mkdtemp(prefix="side_by_side_")
     st = []
