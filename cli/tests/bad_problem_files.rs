@@ -5,8 +5,7 @@
 
 mod common;
 use common::*;
-use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -18,12 +17,6 @@ const PUNCH: &str = "\n[[punch]]\nname = \"roller\"\nshape = \"cylinder\"\npoint
 
 /// The longest message we accept.
 const MAX_MESSAGE: usize = 400;
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
 
 /// 1-based line of the first line of `text` that contains `needle`.
 fn line_of(text: &str, needle: &str) -> usize {
@@ -192,10 +185,6 @@ fn only_regular_files_are_read() {
     let (code, err) = stamp_run(&big, &dir.join("out"), Duration::from_secs(10));
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("big.toml") && err.contains("at most 1048576 bytes"), "{err}");
-}
-
-fn summary(out: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
 /// Steps of the .pvd in order.

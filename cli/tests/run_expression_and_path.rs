@@ -36,10 +36,6 @@ fn history(dir: &Path, name: &str) -> Vec<f64> {
     lines.map(|l| l.split(',').nth(c).unwrap().parse().unwrap()).collect()
 }
 
-fn summary(dir: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
-}
-
 fn newton_per_step(dir: &Path) -> Vec<u64> {
     summary(dir)["steps"].as_array().unwrap().iter().map(|s| s["newton_iterations"].as_u64().unwrap()).collect()
 }

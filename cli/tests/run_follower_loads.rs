@@ -4,19 +4,7 @@
 
 mod common;
 use common::*;
-use serde_json::Value;
 use stamp_cli::run::{build::build, Problem};
-use std::path::PathBuf;
-
-fn write(dir: &PathBuf, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-fn summary(out: &std::path::Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
-}
 
 #[test]
 fn cantilever_roll_example_follows_the_exact_circles_and_closes_at_full_load() {

@@ -7,17 +7,7 @@ mod common;
 use common::*;
 use serde_json::Value;
 use stamp_cli::run::{build::build, Problem};
-use std::path::{Path, PathBuf};
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-fn summary(out: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
-}
+use std::path::Path;
 
 fn last_step(out: &Path) -> Value {
     summary(out)["steps"].as_array().unwrap().last().unwrap().clone()

@@ -4,16 +4,8 @@
 mod common;
 use common::*;
 use serde_json::Value;
-use std::path::PathBuf;
 use std::process::Command;
 use stamp_cli::run::{build::build, Problem};
-
-
-fn write(dir: &PathBuf, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
 
 fn error_of(name: &str, text: &str) -> String {
     let dir = temp_dir(&format!("bad-{name}"));

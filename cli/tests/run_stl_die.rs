@@ -8,12 +8,7 @@ mod common;
 mod stl_common;
 
 use common::*;
-use serde_json::Value;
 use std::path::Path;
-
-fn summary(dir: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
-}
 
 /// (reaction x3 at load factor 1, Newton iterations over all steps) of a problem.
 fn run(problem: &Path, out: &Path) -> (f64, u64) {

@@ -16,6 +16,18 @@ pub fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
+/// Write `text` to `dir`/`name` and return its path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A run's summary.json, parsed.
+pub fn summary(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
 /// A shipped problem file (meshes/`shipped`) with some text replaced, written as `name`.toml to a
 /// fresh folder with the mesh and STL files of meshes/ beside it.
 pub fn variant(name: &str, shipped: &str, edits: &[(&str, &str)]) -> PathBuf {
