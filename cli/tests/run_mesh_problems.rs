@@ -183,9 +183,9 @@ fn sphere_displacement_driven() {
     assert!(r.windows(2).all(|w| w[1] > w[0]) && r[0] > 0.0, "{r:?}");
 }
 
-/// The shipped four-surface example: in equilibrium, penetration within its tolerance, and softer
-/// than the paper's plate on the same mesh by about the model difference the 3D comparison found
-/// (docs/verification.md: -1.8 % at the final travel with the mesh converged; -1.83 % on 20 x 20).
+/// The shipped four-surface example: in equilibrium, penetration within its tolerance, and on its
+/// 20 x 20 mesh within 1 % of the mesh-converged 3D force at the final travel (395.13,
+/// docs/verification.md; measured +0.75 %), where the paper's plate on the same mesh is 6.5 % off.
 #[test]
 fn sphere_with_four_surfaces() {
     let s = check_sphere_quarter("sphere-ss-4surfaces");
@@ -193,8 +193,9 @@ fn sphere_with_four_surfaces() {
     let two_surfaces = variant("sphere-ss-2surfaces", "sphere-ss-4surfaces.toml", &[("\nsurfaces = 4 ", "\nsurfaces = 2 "), ("plot = true", "plot = false")]);
     let (p, _) = run(&two_surfaces, "sphere-ss-2surfaces");
     let last = |s: &Value| -f(&steps(s).last().unwrap()["reaction"][2]);
-    let ratio = last(&s) / last(&p) - 1.0;
-    assert!((-0.025..-0.012).contains(&ratio), "four surfaces against two on the same mesh: {:+.2} %", 100.0 * ratio);
+    let three_d = 395.13;
+    assert!((last(&s) / three_d - 1.0).abs() < 0.01, "four surfaces: {} against 3D {three_d}", last(&s));
+    assert!(last(&p) / three_d - 1.0 > 0.05, "the paper's plate on the same mesh: {} against 3D {three_d}", last(&p));
 }
 
 #[test]

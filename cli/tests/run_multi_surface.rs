@@ -80,9 +80,10 @@ fn a_squeezed_plate_thins_and_spreads_as_3d_elasticity_says() {
 }
 
 /// The cantilever strip of the paper's Table 1 (plane strain, linear): the tip deflection of the
-/// three- and four-surface plates converges to beam theory, F L^3 / (3 D) + F L / (5/6 G h) (the
-/// parabolic shear they can represent), like h^1 from below (measured: -0.47, -0.25, -0.15 % with
-/// three surfaces on 40, 80, 160 elements; see elements/src/multi_surface.rs).
+/// three- and four-surface plates converges like h^2 to within 0.1 % of beam theory,
+/// F L^3 / (3 D) + F L / (5/6 G h) (the parabolic shear they can represent; the rest is the 3D
+/// clamp). Measured, three surfaces on 40, 80, 160 elements: -0.116, -0.097, -0.092 %; without
+/// the element's E33 stabilisation it was -0.47, -0.24, -0.14 % (like h^1).
 #[test]
 fn cantilever_tip_deflection_converges_to_beam_theory() {
     let dir = temp_dir("multi-surface-cantilever");
@@ -91,7 +92,7 @@ fn cantilever_tip_deflection_converges_to_beam_theory() {
     let g = e / (2.0 * (1.0 + nu));
     let beam = f * l * l * l / (3.0 * d) + f * l / (5.0 / 6.0 * g * h);
     for surfaces in [3, 4] {
-        let mut errors = Vec::new();
+        let mut tips = Vec::new();
         for n in [40, 80, 160] {
             let text = CANTILEVER
                 .replace("plane_strain = true\n", &format!("plane_strain = true\nsurfaces = {surfaces}\n"))
@@ -99,12 +100,12 @@ fn cantilever_tip_deflection_converges_to_beam_theory() {
             let path = write(&dir, &format!("c{surfaces}_{n}.toml"), &text);
             let out = dir.join(format!("c{surfaces}_{n}"));
             stamp_cli::run::run(&path, Some(&out), true).unwrap();
-            let w = last_step(&out)["points"]["corner_ur"]["displacement"][2].as_f64().unwrap();
-            errors.push((w - beam) / beam);
+            tips.push(last_step(&out)["points"]["corner_ur"]["displacement"][2].as_f64().unwrap());
         }
-        assert!(errors.iter().all(|&e| e < 0.0), "{surfaces} surfaces: not from below: {errors:?}");
-        assert!(errors[0] / errors[1] > 1.5 && errors[1] / errors[2] > 1.5, "{surfaces} surfaces: not converging: {errors:?}");
-        assert!(errors[2].abs() < 2e-3, "{surfaces} surfaces: {:.3} % off beam theory on 160 elements", 100.0 * errors[2]);
+        let errors: Vec<f64> = tips.iter().map(|w| (w - beam) / beam).collect();
+        assert!(errors.iter().all(|&e| e < 0.0 && e > -1.5e-3), "{surfaces} surfaces: {errors:?} against beam theory");
+        let (d1, d2) = (tips[1] - tips[0], tips[2] - tips[1]);
+        assert!(d1 > 0.0 && d2 > 0.0 && d1 > 3.0 * d2, "{surfaces} surfaces: not converging like h^2: tips {tips:?}");
     }
 }
 
