@@ -282,7 +282,7 @@ pub const ENTRY_FRACTION: f64 = 0.5;
 /// The entry fraction when the active set is empty (the first evaluation, or every point
 /// released): only the deepest penetration enters (a body first touches a punch at a point), with
 /// those within round-off of it. Measured on `stamp bench --problem sphere-displacement`
-/// (2026-11-24, docs/performance.md): the first load step takes 6 / 7 / 9 / 14 Newton iterations at
+/// (2026-11-24, docs/performance.md): the first load step takes 6 / 7 / 6 / 8 Newton iterations at
 /// n = 10 / 20 / 40 / 80 against 12 / 13 / 18 / 23 with 0.7 (a disc of the overlap that enters
 /// takes every point to the punch's tangent plane, whence the convex Psi releases them and the
 /// set shrinks ring by ring). Needs [`LONE_MAX_FLIPS`]: a lone point at a first touch under a
