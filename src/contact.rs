@@ -240,7 +240,8 @@ pub struct ContactPair {
     /// cycling and converges to the exact (non-adhesive) solution.
     pub max_flips: u32,
     /// The same for a change made while at most one point of the pair was active (a lone point
-    /// swinging in and out, the set empty every other iteration): default [`LONE_MAX_FLIPS`].
+    /// swinging in and out, the set empty every other iteration; also every point of a set that
+    /// was emptied and enters again): default [`LONE_MAX_FLIPS`].
     pub lone_max_flips: u32,
     /// The largest |lambda| seen in the current load step (the scale of "near the kink" for
     /// frozen points while every point is momentarily inactive).
