@@ -28,6 +28,9 @@ struct Run {
 fn run(p: &SphereProblem, max_increment: f64, line_search: usize, flip_limit: u32, cycling_after: usize) -> Run {
     let (mesh, mut model) = p.build();
     model.contacts[0].max_flips = flip_limit;
+    // (a set emptied by a wholesale release and entering again would count against
+    // lone_max_flips, 3: the guard under test is max_flips)
+    model.contacts[0].lone_max_flips = flip_limit;
     // the active-set path this test was built to provoke cycling on: every penetrating point
     // enters at the first evaluation, no harder damping at a step's first iteration
     model.contacts[0].first_touch_fraction = None;
