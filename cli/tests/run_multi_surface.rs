@@ -54,12 +54,12 @@ face = "top"
 }
 
 /// 3D elasticity: S33 = -Q, S11 = S22 = 0, so the plate thins by Q h / E and spreads by nu Q / E
-/// in each direction. The three-surface plate gives this exactly; the paper's plate, whose in-plane
+/// in each direction. The plates of 3 to 5 surfaces give this exactly; the paper's plate, whose in-plane
 /// law ignores S33 (b_ab33 = 0), does not spread and thins by Q h / (lambda + 2 mu): the test tells
 /// the two laws apart.
 #[test]
 fn a_squeezed_plate_thins_and_spreads_as_3d_elasticity_says() {
-    let dir = temp_dir("three-surface-squeeze");
+    let dir = temp_dir("multi-surface-squeeze");
     let lam_2mu = E * (1.0 - NU) / ((1.0 + NU) * (1.0 - 2.0 * NU));
     for (model, thinning, spread) in [(3, Q * H / E, NU * Q / E), (4, Q * H / E, NU * Q / E), (5, Q * H / E, NU * Q / E), (2, Q * H / lam_2mu, 0.0)] {
         let path = write(&dir, &format!("s{model}.toml"), &squeeze(model));
@@ -109,7 +109,7 @@ fn cantilever_tip_deflection_converges_to_beam_theory() {
     }
 }
 
-/// A follower pressure on the three-surface plate is balanced by its clamp, as on the paper's.
+/// A follower pressure on a three-surface plate is balanced by its clamp, as on the paper's.
 #[test]
 fn follower_pressure_is_in_equilibrium() {
     let dir = temp_dir("multi-surface-follower");

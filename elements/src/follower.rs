@@ -11,8 +11,8 @@
 //! -p n da = -s p (x,1 x x,2) dxi1 dxi2, with s = +1 on S+ and -1 on S- (the outward normal of S- is
 //! -e3 in the reference) times the sign of the cell's orientation. The nodal forces
 //! F_a = -s p int N_a (x,1 x x,2) dxi are integrated with 2 x 2 Gauss points (exact: the integrand
-//! is at most quadratic in each xi). With [a]x b = a x b, d(x,1 x x,2)/dx_b = N_b,1 (-[x,2]x) +
-//! N_b,2 [x,1]x, so dF_a/dx_b = -s p int N_a (N_b,2 [x,1]x - N_b,1 [x,2]x) dxi: not symmetric per
+//! is at most quadratic in each xi). With \[a\]x b = a x b, d(x,1 x x,2)/dx_b = N_b,1 (-\[x,2\]x) +
+//! N_b,2 \[x,1\]x, so dF_a/dx_b = -s p int N_a (N_b,2 \[x,1\]x - N_b,1 \[x,2\]x) dxi: not symmetric per
 //! cell (it is globally for a closed surface with fixed boundary).
 //!
 //! # Couple on an edge
@@ -32,7 +32,7 @@
 //!   the current fibre. For an edge that turns about M's own axis (a strip rolled up by an end
 //!   moment about the axis of the edge) M stays perpendicular to the fibre and the full M acts at
 //!   any rotation. The load stiffness: with q = d.d,
-//!   df+/dd = [M]x / q - 2 (M x d) d^T / q^2, and dd/dv+ = I, dd/dv- = -I, so
+//!   df+/dd = \[M\]x / q - 2 (M x d) d^T / q^2, and dd/dv+ = I, dd/dv- = -I, so
 //!   dF/dv = [[A, -A], [-A, A]] on (v+, v-) with A = df+/dd.
 //! * `follower = false` ([`fixed_couple_force`]): d is the reference fibre h e3, the pair of
 //!   dead forces f+ = (M x e3) / h, f- = -f+. Its moment is M at the reference state (M3, a twist

@@ -154,8 +154,8 @@ pub struct MultiSurfaceWorkspace<const P: usize, const D: usize> {
 }
 
 /// The N-surface plate elements of a mesh; P = 4 N (node, surface) pairs and D = 12 N dofs per
-/// element (pair 4 a + s... in node-major order: pair N a + s is surface s at node a, local dof
-/// 3 (N a + s) + i its component i).
+/// element, node-major: pair N a + s is surface s at node a, local dof 3 (N a + s) + i its
+/// component i.
 pub struct MultiSurfacePlate<const N: usize, const P: usize, const D: usize> {
     cells: Vec<[usize; 4]>,
     geometry: Vec<ElementGeometry>,

@@ -45,7 +45,7 @@ impl Face {
         self.dof_in(DOFS_PER_NODE, node, comp)
     }
     /// The same in a plate with `dofs_per_node` unknowns per node whose first six are the faces'
-    /// (the paper's plate: 6; the three-surface plate: 9, see [`crate::three_surface`]).
+    /// (the paper's plate: 6; a plate of N surfaces: 3 N, see [`crate::multi_surface`]).
     pub fn dof_in(self, dofs_per_node: usize, node: usize, comp: usize) -> usize {
         node * dofs_per_node + 3 * self.index() + comp
     }

@@ -7,8 +7,8 @@
 //! G_i . G_j (eq. 1.5 in vector form), which vanishes for any rigid motion because a rotation keeps
 //! dot products (eqs. 1.6-1.8). A [`Sample`] stores the value, gradient and (constant) Hessian of
 //! one such strain; the Hessian is a scalar P x P matrix over the (node, surface) pairs times the
-//! 3 x 3 identity. P = 8 (4 nodes x 2 faces) for the paper's plate; the three-surface plate
-//! ([`crate::three_surface`]) uses the same types with P = 12.
+//! 3 x 3 identity. P = 8 (4 nodes x 2 faces) for the paper's plate; the plate of N surfaces
+//! ([`crate::multi_surface`]) uses the same types with P = 4 N.
 
 /// Element dofs: 4 nodes x 2 faces x 3 components; local dof 3k + i is component i of the
 /// displacement of (node, face) pair k = 2 node + face (face 0 = S-, 1 = S+).

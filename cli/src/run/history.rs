@@ -109,7 +109,7 @@ impl History {
         }
     }
 
-    /// The same for a plate with another layout of its unknowns (the three-surface plate's).
+    /// The same for a plate with another layout of its unknowns (a plate of more than two surfaces).
     pub fn with_layout(mut self, layout: Layout) -> History {
         self.layout = layout;
         self

@@ -3,8 +3,8 @@
 //!
 //! The estimate covers the mesh, the sparse tangent and its pattern, the preconditioner and the
 //! LDL^T factor, whose fill grows like N log2 N for a nested-dissection ordering of a 2D mesh
-//! (N unknowns: 6 per node in the paper's plate, 9 in the three-surface plate). Calibrated on `stamp bench` (quarter plate, n x n cells): peak RSS
-//! 1.36 GiB at n = 200 (241 200 unknowns) and 5.85 GiB at n = 400 (961 600 unknowns); the formula
+//! (N unknowns: 6 per node in the paper's plate, 3 per surface in the others). Calibrated on
+//! `stamp bench` (quarter plate, n x n cells): peak RSS 1.36 GiB at n = 200 (241 200 unknowns) and 5.85 GiB at n = 400 (961 600 unknowns); the formula
 //! gives 1.44 and 6.14 GiB, a little on the safe side. Measured again with /usr/bin/time -v
 //! (`stamp bench --one n`, 2026-11-24): n = 50 peaks at 0.077 GiB (estimate 0.13), n = 100 at
 //! 0.32 GiB (estimate 0.37).
