@@ -45,7 +45,7 @@
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section};
 use crate::plate::Kinematics;
-use crate::strain::{Affine, Sample};
+use crate::strain::{axpy, triple, Affine, Sample};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par};
 use stamp::element::{Element, LocalSystem};
@@ -251,15 +251,15 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
                 let g2 = Self::tangent(geo.frame[1], [dn[0][1], dn[1][1], dn[2][1], dn[3][1]], &lv.l, v);
                 let g3 = Self::transverse(&geo.n[g], &lv.dl, v);
                 volume_ratio = volume_ratio.min(triple(&g1.g, &g2.g, &g3.g) / reference);
-                put(&mut s[4 * g], full, 0.5, &g1, &g1);
-                put(&mut s[4 * g + 1], full, 0.5, &g2, &g2);
-                put(&mut s[4 * g + 2], full, 1.0, &g1, &g2);
-                put(&mut s[4 * g + 3], full, 0.5, &g3, &g3);
+                s[4 * g].set(full, 0.5, &g1, &g1);
+                s[4 * g + 1].set(full, 0.5, &g2, &g2);
+                s[4 * g + 2].set(full, 1.0, &g1, &g2);
+                s[4 * g + 3].set(full, 0.5, &g3, &g3);
             }
             for (t, sp) in geo.tying.iter().enumerate() {
                 let gt = Self::tangent(sp.base, sp.dn, &lv.l, v);
                 let g3 = Self::transverse(&sp.n, &lv.dl, v);
-                put(&mut s[TYING_SAMPLE + t], full, 1.0, &gt, &g3);
+                s[TYING_SAMPLE + t].set(full, 1.0, &gt, &g3);
             }
         }
         ws.volume_ratio = volume_ratio;
@@ -357,26 +357,12 @@ fn stress(l: f64, m: f64, e: &[f64; NVOIGT]) -> [f64; NVOIGT] {
     [l * tr + 2.0 * m * e[0], l * tr + 2.0 * m * e[1], l * tr + 2.0 * m * e[2], m * e[3], m * e[4], m * e[5]]
 }
 
-/// a . (b x c)
-fn triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
-    a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
-}
-
-/// The strain s gA . gB - its reference value, full (Green-Lagrange) or linear part.
-#[inline(always)]
-fn put<const P: usize, const D: usize>(sample: &mut Sample<P, D>, full: bool, scale: f64, a: &Affine<P>, b: &Affine<P>) {
-    if full {
-        sample.quadratic(scale, a, b)
-    } else {
-        sample.linear(scale, a, b)
-    }
-}
 
 impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePlate<N, P, D> {
     type Workspace = MultiSurfaceWorkspace<P, D>;
 
     fn dofs_per_node(&self) -> usize {
-        3 * N
+        Self::DOFS_PER_NODE
     }
     fn nodes_per_element(&self) -> usize {
         4
@@ -491,14 +477,6 @@ impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePla
                 }
             }
         }
-    }
-}
-
-/// y += a x over the element dofs.
-#[inline(always)]
-fn axpy<const D: usize>(y: &mut [f64; D], a: f64, x: &[f64; D]) {
-    for (yi, &xi) in y.iter_mut().zip(x) {
-        *yi += a * xi;
     }
 }
 

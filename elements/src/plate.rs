@@ -11,7 +11,7 @@
 
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section, NSTRAIN};
-use crate::strain::{Affine, Sample, NDOF, NPAIR};
+use crate::strain::{axpy, triple, Affine, Sample, NDOF, NPAIR};
 use stamp::element::{Element, LocalSystem};
 use stamp::linalg::vector_state::clean_upper_vector_state;
 use stamp::mesh::QuadMesh;
@@ -70,11 +70,6 @@ const MEMBRANE_GROUP_FIRST: [[usize; 4]; 3] = [[0, 0, 2, 2], [0, 1, 1, 0], [0, 0
 /// Row of T33 (and E33) in D.
 const E33_ROW: usize = crate::material::idx::E33;
 
-/// a . (b x c)
-fn triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
-    a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
-}
-
 /// The deformed transverse fibre g3 = e3 + (v+ - v-)/h at the point with shape functions `n`.
 #[inline(always)]
 fn fibre(n: &[f64; 4], h: f64, v: &[f64]) -> Affine {
@@ -94,16 +89,6 @@ fn face_tangent(g0: [f64; 2], dn: [f64; 4], face: usize, v: &[f64]) -> Affine {
         c[2 * a + face] = dn[a];
     }
     Affine::new([g0[0], g0[1], 0.0], c, v)
-}
-
-/// The strain s gA . gB - its reference value, full or linear part.
-#[inline(always)]
-fn put(sample: &mut Sample, full: bool, scale: f64, a: &Affine, b: &Affine) {
-    if full {
-        sample.quadratic(scale, a, b)
-    } else {
-        sample.linear(scale, a, b)
-    }
 }
 
 /// Per-thread scratch memory of the plate element.
@@ -238,16 +223,16 @@ impl PlateElements {
         let mut volume_ratio = f64::INFINITY;
         for g in 0..4 {
             let g3 = fibre(&geo.n[g], h, v);
-            put(&mut s[E33 + g], nonlinear, 0.5, &g3, &g3);
+            s[E33 + g].set(nonlinear, 0.5, &g3, &g3);
             let dn = geo.dndy[g];
             for face in 0..2 {
                 let g1 = face_tangent(geo.frame[0], [dn[0][0], dn[1][0], dn[2][0], dn[3][0]], face, v);
                 let g2 = face_tangent(geo.frame[1], [dn[0][1], dn[1][1], dn[2][1], dn[3][1]], face, v);
                 volume_ratio = volume_ratio.min(triple(&g1.g, &g2.g, &g3.g) / reference);
                 let base = MEM + g * 6 + face * 3;
-                put(&mut s[base], nonlinear, 0.5, &g1, &g1);
-                put(&mut s[base + 1], nonlinear, 0.5, &g2, &g2);
-                put(&mut s[base + 2], nonlinear, 1.0, &g1, &g2);
+                s[base].set(nonlinear, 0.5, &g1, &g1);
+                s[base + 1].set(nonlinear, 0.5, &g2, &g2);
+                s[base + 2].set(nonlinear, 1.0, &g1, &g2);
             }
         }
         ws.volume_ratio = volume_ratio;
@@ -258,7 +243,7 @@ impl PlateElements {
             let g3 = fibre(&sp.n, h, v);
             for face in 0..2 {
                 let gt = face_tangent(sp.base, sp.dn, face, v);
-                put(&mut s[base + pt * 2 + face], nonlinear, 1.0, &gt, &g3);
+                s[base + pt * 2 + face].set(nonlinear, 1.0, &gt, &g3);
             }
         }
     }
@@ -504,14 +489,6 @@ impl PlateElements {
                 }
             }
         }
-    }
-}
-
-/// y += a x over the element dofs (fixed size and distinct borrows: vectorised, no bounds checks).
-#[inline(always)]
-fn axpy(y: &mut [f64; NDOF], a: f64, x: &[f64; NDOF]) {
-    for (yi, &xi) in y.iter_mut().zip(x) {
-        *yi += a * xi;
     }
 }
 

@@ -81,6 +81,17 @@ impl<const P: usize, const D: usize> Sample<P, D> {
         self.b = b.c;
     }
 
+    /// The strain s (gA . gB - g0A . g0B): [`quadratic`](Self::quadratic) if `full` (geometrically
+    /// nonlinear), else [`linear`](Self::linear).
+    #[inline(always)]
+    pub fn set(&mut self, full: bool, s: f64, a: &Affine<P>, b: &Affine<P>) {
+        if full {
+            self.quadratic(s, a, b)
+        } else {
+            self.linear(s, a, b)
+        }
+    }
+
     /// Hessian coefficient (k, l) over the (node, surface) pairs.
     pub fn hessian(&self, k: usize, l: usize) -> f64 {
         self.scale * (self.a[k] * self.b[l] + self.b[k] * self.a[l])
@@ -99,5 +110,19 @@ impl<const P: usize, const D: usize> Sample<P, D> {
             }
         }
         self.scale = 0.0;
+    }
+}
+
+/// a . (b x c)
+#[inline(always)]
+pub fn triple(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
+    a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
+}
+
+/// y += a x over the element dofs (fixed size and distinct borrows: vectorised, no bounds checks).
+#[inline(always)]
+pub fn axpy<const D: usize>(y: &mut [f64; D], a: f64, x: &[f64; D]) {
+    for (yi, &xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
     }
 }
