@@ -77,8 +77,7 @@ fn face_of(f: PunchFace) -> Face {
 
 /// Put a nodal force on a face, or on the mid-plane (half on each face of the paper's plate, on
 /// each surface its weight in the mid-plane's displacement in the others).
-fn add_force(model: &mut Model<Plate>, node: usize, f: [f64; 3], face: LoadFace) -> Result<()> {
-    let layout = Layout::of(&model.element);
+fn add_force(model: &mut Model<Plate>, layout: &Layout, node: usize, f: [f64; 3], face: LoadFace) -> Result<()> {
     for c in 0..3 {
         if f[c] == 0.0 {
             continue;
@@ -226,7 +225,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                     let (a, b) = (mesh.mesh.coords[s[0]], mesh.mesh.coords[s[1]]);
                     let len = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
                     for &n in s {
-                        add_force(&mut model, n, f.map(|x| 0.5 * len * x), face)?;
+                        add_force(&mut model, &layout, n, f.map(|x| 0.5 * len * x), face)?;
                     }
                 }
             }
@@ -254,7 +253,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                 let w = mesh.nodal_areas_of(cells);
                 for (n, &a) in w.iter().enumerate() {
                     if a > 0.0 {
-                        add_force(&mut model, n, f.map(|x| a * x), face)?;
+                        add_force(&mut model, &layout, n, f.map(|x| a * x), face)?;
                     }
                 }
             }
@@ -277,15 +276,15 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                 } else {
                     for (n, mn) in couples {
                         let f = fixed_couple_force(mn, h);
-                        add_force(&mut model, n, f, LoadFace::Top)?;
-                        add_force(&mut model, n, f.map(|x| -x), LoadFace::Bottom)?;
+                        add_force(&mut model, &layout, n, f, LoadFace::Top)?;
+                        add_force(&mut model, &layout, n, f.map(|x| -x), LoadFace::Bottom)?;
                     }
                 }
             }
             LoadKind::Point => {
                 let nodes = mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "", &mesh))?;
                 for n in nodes {
-                    add_force(&mut model, n, ls.force.unwrap().0, face)?;
+                    add_force(&mut model, &layout, n, ls.force.unwrap().0, face)?;
                 }
             }
         }

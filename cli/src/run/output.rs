@@ -27,7 +27,7 @@ use stamp::element::Element;
 use stamp::io::Field;
 use stamp::model::Model;
 use super::plate_model::{Layout, Plate};
-use stamp_elements::{Face, PlateElements, Section};
+use stamp_elements::{Face, Section};
 use std::collections::BTreeMap;
 
 /// Names of the point arrays of every .vtu (gap only with punches).
@@ -137,51 +137,8 @@ pub struct ContactRow {
 }
 
 /// Stress resultants at the element centres.
-pub fn cell_fields(model: &Model<Plate>, section: &Section, u: &[f64]) -> Vec<Field> {
-    match &model.element {
-        Plate::TwoSurface(plate) => two_surface_cell_fields(plate, section, u),
-        plate => multi_surface_cell_fields(plate, u),
-    }
-}
-
-/// The resultants of the paper's plate from its face resultants T- and T+ (eq. 2.7).
-fn two_surface_cell_fields(plate: &PlateElements, section: &Section, u: &[f64]) -> Vec<Field> {
-    let mut ws = plate.new_workspace();
-    let ne = plate.num_elements();
-    let half_h = 0.5 * section.thickness();
-    let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(ne); 9];
-    let mut local = vec![0.0; 24];
-    for e in 0..ne {
-        for (a, &n) in plate.element_nodes(e).iter().enumerate() {
-            local[6 * a..6 * a + 6].copy_from_slice(&u[6 * n..6 * n + 6]);
-        }
-        let gs = plate.gauss_state(e, &local, &mut ws);
-        let mut t = [0.0; 11];
-        for g in 0..4 {
-            for r in 0..11 {
-                t[r] += 0.25 * gs.resultant[g][r];
-            }
-        }
-        let vals = [
-            t[0] + t[1],
-            t[2] + t[3],
-            t[4] + t[5],
-            half_h * (t[1] - t[0]),
-            half_h * (t[3] - t[2]),
-            half_h * (t[5] - t[4]),
-            t[6] + t[7],
-            t[8] + t[9],
-            t[10],
-        ];
-        for (k, v) in vals.iter().enumerate() {
-            out[k].push(*v);
-        }
-    }
-    CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect()
-}
-
-/// The resultants of a plate of more than two surfaces, integrated through the thickness.
-fn multi_surface_cell_fields(plate: &Plate, u: &[f64]) -> Vec<Field> {
+pub fn cell_fields(model: &Model<Plate>, u: &[f64]) -> Vec<Field> {
+    let plate = &model.element;
     let mut ws = plate.new_workspace();
     let ne = plate.num_elements();
     let dpn = plate.dofs_per_node();
@@ -191,7 +148,7 @@ fn multi_surface_cell_fields(plate: &Plate, u: &[f64]) -> Vec<Field> {
         for (a, &n) in plate.element_nodes(e).iter().enumerate() {
             local[dpn * a..dpn * (a + 1)].copy_from_slice(&u[dpn * n..dpn * (n + 1)]);
         }
-        let r = plate.multi_surface_resultants(e, &local, &mut ws).expect("a plate of more than two surfaces");
+        let r = plate.centre_resultants(e, &local, &mut ws);
         let vals = [r.n[0], r.n[1], r.n[2], r.m[0], r.m[1], r.m[2], r.q[0], r.q[1], r.t33];
         for (k, v) in vals.iter().enumerate() {
             out[k].push(*v);
@@ -379,7 +336,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         vtu: None,
         csv: Vec::new(),
     };
-    StepData { entry, point_fields, cell_fields: cell_fields(model, cx.section, u), punch_rows }
+    StepData { entry, point_fields, cell_fields: cell_fields(model, u), punch_rows }
 }
 
 /// The contact CSV of one punch: one row per candidate node, in the order given.

@@ -58,15 +58,32 @@ impl Plate {
     pub fn surfaces(&self) -> usize {
         Element::dofs_per_node(self) / 3
     }
-    /// The resultants at the centre of element `e` of a plate of more than two surfaces, at the
-    /// local dofs `v`; None for the paper's plate (its resultants come from its own face
-    /// resultants).
-    pub fn multi_surface_resultants(&self, e: usize, v: &[f64], ws: &mut PlateWs) -> Option<Resultants> {
+    /// The section's resultants at the centre of element `e` at the local dofs `v` (the mean over
+    /// its Gauss points): membrane forces, moments about the mid-plane, shear forces and T33. The
+    /// paper's plate gives them from its face resultants T- and T+ (eq. 2.7), the others by
+    /// integrating the stresses through the thickness.
+    pub fn centre_resultants(&self, e: usize, v: &[f64], ws: &mut PlateWs) -> Resultants {
         match (self, ws) {
-            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => Some(p.resultants(e, v, w)),
-            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => Some(p.resultants(e, v, w)),
-            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => Some(p.resultants(e, v, w)),
-            _ => None,
+            (Plate::TwoSurface(p), PlateWs::TwoSurface(w)) => {
+                let gs = p.gauss_state(e, v, w);
+                let mut t = [0.0; 11];
+                for g in 0..4 {
+                    for r in 0..11 {
+                        t[r] += 0.25 * gs.resultant[g][r];
+                    }
+                }
+                let half_h = 0.5 * p.section().thickness();
+                Resultants {
+                    n: [t[0] + t[1], t[2] + t[3], t[4] + t[5]],
+                    m: [half_h * (t[1] - t[0]), half_h * (t[3] - t[2]), half_h * (t[5] - t[4])],
+                    q: [t[6] + t[7], t[8] + t[9]],
+                    t33: t[10],
+                }
+            }
+            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.resultants(e, v, w),
+            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.resultants(e, v, w),
+            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.resultants(e, v, w),
+            _ => unreachable!("a workspace is made by its own plate"),
         }
     }
 }
@@ -77,14 +94,17 @@ impl Plate {
 pub struct Layout {
     pub surfaces: usize,
     pub dofs_per_node: usize,
+    /// zeta in [-1, 1] of each surface, in the order of the unknowns.
+    zetas: Vec<f64>,
     /// Weights of the surfaces' displacements in the mid-plane's (the Lagrange functions at zeta = 0).
     mid_weights: Vec<f64>,
 }
 
 impl Layout {
     pub fn new(surfaces: usize) -> Layout {
-        let mid_weights = if surfaces == 2 { vec![0.5, 0.5] } else { lagrange(&surface_zetas(surfaces), 0.0).0 };
-        Layout { surfaces, dofs_per_node: 3 * surfaces, mid_weights }
+        let zetas = surface_zetas(surfaces);
+        let mid_weights = lagrange(&zetas, 0.0).0;
+        Layout { surfaces, dofs_per_node: 3 * surfaces, zetas, mid_weights }
     }
     pub fn of(plate: &Plate) -> Layout {
         Layout::new(plate.surfaces())
@@ -113,7 +133,7 @@ impl Layout {
     }
     /// zeta in [-1, 1] of the surface that holds component `c` (0 .. dofs per node) of a node.
     pub fn zeta_of_component(&self, c: usize) -> f64 {
-        surface_zetas(self.surfaces)[c / 3]
+        self.zetas[c / 3]
     }
     /// The constrained components of a boundary word, extended to this plate: a word that holds a
     /// component on both faces (v1, symmetry_x1, simply_supported, clamped, ...) holds it on the
