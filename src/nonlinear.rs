@@ -84,7 +84,10 @@ pub struct NewtonSettings {
     pub rel_tol: f64,
     pub abs_tol: f64,
     /// Round-off floor: once |R| <= floor_tol * force scale and an iteration no longer halves |R|
-    /// (with an unchanged active set), the iterate is as converged as floating point allows.
+    /// (with an unchanged active set), the iterate is as converged as floating point allows. So it
+    /// is, at once, when |R| <= loose_tol * force scale and the correction that led there had an
+    /// energy below [`energy_tol`](Self::energy_tol) times the first's (quadratic convergence: the
+    /// next iteration would only confirm the stall).
     pub floor_tol: f64,
     /// Also converged when the last correction was below disp_tol * max |u| (the displacements are
     /// fixed to round-off) and |R| <= loose_tol * force scale: the residual of a stiff penalty
@@ -375,7 +378,12 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             let flat = it > 0 && ev.residual_norm > 0.8 * history[history.len() - 2];
             let path_energy = flat && last_energy <= s.energy_tol * *peak_energy && ev.residual_norm <= s.loose_tol * ev.force_scale;
             let energy = it > 1 && stalled && (own_energy || path_energy);
-            if ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || fixed || energy {
+            // near the round-off floor after a correction whose energy fell below energy_tol of the
+            // first: Newton has converged quadratically, and a further iteration can only confirm
+            // the stall (the penalty's |R| floor lies above rel_tol, and on fine meshes above
+            // floor_tol)
+            let settled = it > 1 && ev.residual_norm <= s.loose_tol * ev.force_scale && last_energy <= s.energy_tol * first_energy;
+            if ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || settled || fixed || energy {
                 if ev.active_changes == 0 {
                     if first_energy.is_finite() {
                         *peak_energy = peak_energy.max(first_energy);
