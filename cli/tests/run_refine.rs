@@ -179,11 +179,17 @@ fn table_history_and_summary_agree_with_the_refined_run() {
     assert_eq!(hf.len(), col(&h, "max_deflection"), "the plain columns first, the new ones at the end: {h:?}");
     assert_eq!(rows.len(), coarse_lf.len());
     let table: Vec<&str> = stdout.lines().collect();
-    let head = table.iter().position(|l| l.contains("refined (force)")).unwrap_or_else(|| panic!("no estimate columns:\n{stdout}"));
-    assert!(table[head - 1].contains("sphere force:") && table[head - 1].contains("max deflection:"), "{stdout}");
-    for needle in ["estimate (force)", "error %", "refined error %", "max deflection (length)"] {
-        assert!(table[head].contains(needle), "{needle}: {stdout}");
+    // under the run's table, one table per key result: its name, the header, a row per step
+    for (name, unit) in [("sphere force:", "force"), ("max deflection:", "length")] {
+        let at = table.iter().position(|l| l.trim() == name).unwrap_or_else(|| panic!("no table of {name}\n{stdout}"));
+        for needle in [format!("this mesh ({unit})"), format!("refined ({unit})"), format!("estimate ({unit})"), "error %".into(), "refined error %".into()] {
+            assert!(table[at + 1].contains(&needle), "{needle}: {stdout}");
+        }
+        assert_eq!(table[at + 2].split_whitespace().next(), Some("1"), "{stdout}");
     }
+    let head = table.iter().position(|l| l.trim() == "sphere force:").unwrap() + 1;
+    // the refinement's tables and explanation fit a terminal (the run's own table is as without --refine)
+    assert!(table[head..].iter().filter(|l| !l.starts_with("stamp run:")).all(|l| l.chars().count() <= 100), "a line wider than 100 characters:\n{stdout}");
     assert!(stdout.contains("p = 2 assumed"), "the table says which order it assumed:\n{stdout}");
     for (i, row) in rows.iter().enumerate() {
         let entry = &s["refinement"]["steps"][i];
@@ -200,7 +206,7 @@ fn table_history_and_summary_agree_with_the_refined_run() {
         let pct = 100.0 * (f0 - est) / est.abs();
         assert!((row[col(&h, "sphere_force_error_pct")] - pct).abs() < 1e-6, "step {}", i + 1);
         assert!((row[col(&h, "sphere_force_refined_error_pct")] - 100.0 * (f1 - est) / est.abs()).abs() < 1e-6);
-        // the table's row shows the same numbers
+        // the force table's row shows the same numbers
         let cells: Vec<&str> = table[head + 1 + i].split_whitespace().collect();
         let text = stamp_cli::run::refine_report::percent(Some(pct));
         assert!(cells.contains(&text.as_str()), "step {}: {text} not in {:?}", i + 1, cells);

@@ -186,28 +186,29 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         v["refinement"]["seconds"] = json!(seconds);
     })?;
     if !quiet {
-        print!("{}", super::table::render_with(&coarse.history, &units, rep.columns(&coarse.history)));
+        print!("{}", super::table::render(&coarse.history, &units));
+        print!("{}", rep.tables(&coarse.history));
         println!("{}", explanation(levels));
     }
     Ok(RunOutcome { files, ..coarse })
 }
 
-/// The line under the table that says how to read the estimate.
+/// The lines under the tables that say how to read the estimate (each under 100 characters).
 pub fn explanation(levels: usize) -> String {
+    let error = "error %: each run's estimated error, 100 (F - estimate) / |estimate|.";
     if levels == 1 {
         format!(
-            "refined: the same steps on the mesh refined once (each cell into 4); estimate: Richardson extrapolation \
-             F_refined + (F_refined - F) / (2^p - 1) with the element's order p = {} assumed (contact forces on coarse \
-             meshes often converge more slowly, p = 1 .. 1.5: then the error is up to about 1.6 times the estimated one; \
-             --refine 2 observes p); error %: each run's estimated error, 100 (F - estimate) / |estimate|",
+            "\nrefined: the same steps on the mesh refined once (each cell into 4).\n\
+             estimate: Richardson extrapolation F_refined + (F_refined - F) / (2^p - 1), p = {} assumed\n\
+             (the element's order); contact forces on coarse meshes often converge more slowly, p = 1 .. 1.5,\n\
+             and their error can then be up to about 1.6 times the estimated one: --refine 2 observes p.\n{error}",
             super::richardson::ASSUMED_ORDER
         )
     } else {
         format!(
-            "refined, refined 2, ...: the same steps on the mesh refined once, twice, ... (each cell into 4 every time); \
-             estimate: Richardson extrapolation of the two finest with the order observed on the last three \
-             (the assumed p = {} where the observed one is not between {} and {}); error %: each run's estimated error, \
-             100 (F - estimate) / |estimate|",
+            "\nrefined, refined 2, ...: the same steps on the mesh refined once, twice, ... (each cell into 4).\n\
+             estimate: Richardson extrapolation of the two finest with the order observed on the last three\n\
+             (the assumed p = {} where the observed one is not between {} and {}).\n{error}",
             super::richardson::ASSUMED_ORDER,
             super::richardson::MIN_OBSERVED,
             super::richardson::MAX_OBSERVED

@@ -1,7 +1,7 @@
 //! What `stamp run --refine` reports: the key results of the run on the problem's mesh and on its
 //! refinements at the same load steps, their Richardson estimate ([`super::richardson`]) and each
-//! run's estimated error, as extra columns of the table and of history.csv and as summary.json's
-//! `refinement.steps`.
+//! run's estimated error, as tables under the run's table (one per key result), as extra columns
+//! of history.csv and as summary.json's `refinement.steps`.
 //!
 //! The key results ([`quantities`]): the force of every displacement-driven (or fixed) punch
 //! (`<punch>_force`), the travel of every force-driven punch (`<punch>_travel`; its force is given), the mid-surface deflection of largest magnitude over the
@@ -14,7 +14,7 @@
 
 use super::history::{sig, History, HistoryRow};
 use super::richardson::{extrapolate, Estimate, ASSUMED_ORDER};
-use super::table::{column, Column};
+use super::table::{column, render_columns, step_columns};
 use super::units::Units;
 use serde_json::{json, Map, Value};
 
@@ -170,22 +170,22 @@ impl Report {
         out
     }
 
-    /// The table's extra columns: per key result (but the named points) the refined values, the
-    /// estimate and each run's estimated error in percent (and the order used, with two levels).
-    pub fn columns(&self, coarse: &History) -> Vec<Column> {
-        let mut cols = Vec::new();
+    /// The tables under the run's table: one per key result (but the named points), a row per
+    /// step with this run's value, the refined values, the estimate and each run's estimated error
+    /// in percent (and the order used, with two levels or more).
+    pub fn tables(&self, coarse: &History) -> String {
+        let mut out = String::new();
         for (i, q) in self.quantities.iter().enumerate() {
             if !q.in_table() {
                 continue;
             }
+            let mut cols = step_columns(coarse);
             let mut group = format!("{}:", q.label);
             let mut take = |header: String, values: Vec<String>| {
                 cols.push(column(std::mem::take(&mut group), header, values));
             };
             let est = |f: &dyn Fn(&Estimate) -> String| self.steps.iter().map(|(_, e)| f(&e[i])).collect::<Vec<String>>();
-            if q.kind == Kind::MaxDeflection {
-                take(Units::label("max deflection", &q.unit), coarse.rows.iter().map(|r| sig(r.max_deflection)).collect());
-            }
+            take(Units::label("this mesh", &q.unit), est(&|e| sig(e.values[0])));
             for l in 1..=self.levels {
                 let name = if l == 1 { "refined".to_string() } else { format!("refined {l}") };
                 take(Units::label(&name, &q.unit), est(&|e| sig(e.values[l])));
@@ -199,8 +199,10 @@ impl Report {
             if self.levels >= 2 {
                 take("order".into(), est(&|e| format!("{:.2}", e.order)));
             }
+            out.push('\n');
+            out.push_str(&render_columns(&cols));
         }
-        cols
+        out
     }
 
     /// summary.json's `refinement.steps`: per coarse step its load factor, the finer runs' step
@@ -319,9 +321,17 @@ mod tests {
         assert!((row[at("ball_force_refined_error_pct")] - 100.0 * (2.0 / 3.0) / e.value).abs() < 1e-9);
         assert_eq!(row[at("max_deflection")], -2.0);
         assert_eq!(row[at("center_u3_refined")], -1.8);
-        let table = crate::run::table::render_with(&coarse, &units(), r.columns(&coarse));
-        assert!(table.contains("ball force:") && table.contains("estimate (N)") && table.contains("refined error %") && !table.contains("center u3"), "{table}");
-        assert!(table.lines().nth(3).unwrap().contains("17.3333") && table.lines().nth(3).unwrap().contains("+15.385") && table.lines().nth(3).unwrap().contains("+3.846"), "{table}");
+        let tables = r.tables(&coarse);
+        let lines: Vec<&str> = tables.lines().collect();
+        // a blank line, then per key result its name, the header and one row per step
+        assert_eq!(lines.len(), 2 * 5, "{tables}");
+        assert!(lines[1].contains("ball force:") && lines[6].contains("max deflection:") && !tables.contains("center u3"), "{tables}");
+        for head in ["step", "load factor", "this mesh (N)", "refined (N)", "estimate (N)", "error %", "refined error %"] {
+            assert!(lines[2].contains(head), "{head}: {tables}");
+        }
+        let last: Vec<&str> = lines[4].split_whitespace().collect();
+        assert_eq!(last, ["2", "1.00000", "20.0000", "18.0000", "17.3333", "+15.385", "+3.846"], "{tables}");
+        assert!(lines[9].contains("-2.00000") && lines[9].contains("-1.80000"), "{tables}");
         let j = r.json_steps(&coarse);
         assert_eq!(j[1]["results"]["ball_force"]["values"], json!([20.0, 18.0]));
         assert!((j[1]["results"]["ball_force"]["errors_percent"][0].as_f64().unwrap() - 15.384615).abs() < 1e-5);

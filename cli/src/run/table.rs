@@ -24,17 +24,10 @@ pub fn column(group: String, header: impl Into<String>, values: Vec<String>) -> 
 
 /// The table text (ends with a newline; empty when no step converged).
 pub fn render(h: &History, units: &Units) -> String {
-    render_with(h, units, Vec::new())
-}
-
-/// The table with `extra` columns after the Newton iterations (`stamp run --refine`).
-pub fn render_with(h: &History, units: &Units, extra: Vec<Column>) -> String {
     if h.rows.is_empty() {
         return String::new();
     }
-    let mut cols: Vec<Column> = Vec::new();
-    cols.push(column(String::new(), "step", h.rows.iter().map(|r| r.step.to_string()).collect()));
-    cols.push(column(String::new(), "load factor", h.rows.iter().map(|r| sig(r.load_factor)).collect()));
+    let mut cols = step_columns(h);
     for (k, name) in h.punch_names.iter().enumerate() {
         let quantities: [(String, Quantity); 5] = [
             (Units::label("travel", &units.length), |p| p.travel),
@@ -49,7 +42,21 @@ pub fn render_with(h: &History, units: &Units, extra: Vec<Column>) -> String {
         }
     }
     cols.push(column(String::new(), "Newton", h.rows.iter().map(|r| r.newton_iterations.to_string()).collect()));
-    cols.extend(extra);
+    render_columns(&cols)
+}
+
+/// The step and load-factor columns of a history (the first two of every table).
+pub fn step_columns(h: &History) -> Vec<Column> {
+    vec![
+        column(String::new(), "step", h.rows.iter().map(|r| r.step.to_string()).collect()),
+        column(String::new(), "load factor", h.rows.iter().map(|r| sig(r.load_factor)).collect()),
+    ]
+}
+
+/// Columns as a table: right-aligned under the header, the groups' line above it when any column
+/// has a group; one row per value.
+pub fn render_columns(cols: &[Column]) -> String {
+    let rows = cols.first().map(|c| c.values.len()).unwrap_or(0);
     let widths: Vec<usize> = cols.iter().map(|c| c.values.iter().map(|s| s.len()).chain([c.header.chars().count(), c.group.chars().count()]).max().unwrap_or(0)).collect();
     let mut out = String::new();
     if cols.iter().any(|c| !c.group.is_empty()) {
@@ -60,7 +67,7 @@ pub fn render_with(h: &History, units: &Units, extra: Vec<Column>) -> String {
     let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:>w$}", c.header)).collect();
     out.push_str(&line.join("  "));
     out.push('\n');
-    for i in 0..h.rows.len() {
+    for i in 0..rows {
         let line: Vec<String> = cols.iter().zip(&widths).map(|(c, &w)| format!("{:>w$}", c.values[i])).collect();
         out.push_str(&line.join("  "));
         out.push('\n');
