@@ -205,7 +205,7 @@ impl Assembler {
                         ue[a * dpn + c] = u[n * dpn + c];
                     }
                 }
-                local.clear_for(with_tangent);
+                local.clear(with_tangent);
                 element.evaluate(e, ue, ws, local, with_tangent);
                 if local.inadmissible.is_some() {
                     return (0.0, e);

@@ -31,15 +31,11 @@ impl LocalSystem {
     pub fn num_dofs(&self) -> usize {
         self.residual.len()
     }
-    /// Zero everything.
-    pub fn clear(&mut self) {
-        self.clear_for(true);
-    }
     /// Zero what an evaluation with or without the tangent fills: a residual-only evaluation
     /// leaves the tangent and preconditioner arrays alone (nothing reads them then; clearing a
     /// 24 x 24 or 48 x 48 array per element cost more than the paper's residual kernel spends on
     /// some of its sums).
-    pub fn clear_for(&mut self, with_tangent: bool) {
+    pub fn clear(&mut self, with_tangent: bool) {
         self.residual.fill(0.0);
         if with_tangent {
             self.tangent.fill(0.0);

@@ -608,7 +608,7 @@ mod element_measurement {
                             for (a, &node) in plate.element_nodes(e).iter().enumerate() {
                                 ue[6 * a..6 * a + 6].copy_from_slice(&u[6 * node..6 * node + 6]);
                             }
-                            out.clear_for(tangent);
+                            out.clear(tangent);
                             plate.evaluate(e, &ue, &mut ws, &mut out, tangent);
                             check += out.tangent[25] + out.residual[3];
                         }
