@@ -45,7 +45,7 @@
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section};
 use crate::plate::Kinematics;
-use crate::strain::{axpy, triple, Affine, Sample};
+use crate::strain::{add_geometric_stiffness, axpy, triple, Affine, Sample};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par};
 use stamp::element::{Element, LocalSystem};
@@ -468,14 +468,7 @@ impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePla
                     }
                 }
             }
-            for p in 0..P {
-                for l in 0..P {
-                    let val = x[p][l] + x[l][p];
-                    for i in 0..3 {
-                        out.tangent[(3 * p + i) * D + 3 * l + i] += val;
-                    }
-                }
-            }
+            add_geometric_stiffness(&x, &mut out.tangent);
         }
     }
 }

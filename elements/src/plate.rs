@@ -11,7 +11,7 @@
 
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section, NSTRAIN};
-use crate::strain::{axpy, triple, Affine, Sample, NDOF, NPAIR};
+use crate::strain::{add_geometric_stiffness, axpy, triple, Affine, Sample, NDOF, NPAIR};
 use stamp::element::{Element, LocalSystem};
 use stamp::linalg::vector_state::clean_upper_vector_state;
 use stamp::mesh::QuadMesh;
@@ -475,18 +475,9 @@ impl PlateElements {
             for s in shear..shear + 8 {
                 add(s, &face_pairs(s % 2), &all);
             }
-            for kk in 0..NPAIR {
-                for l in 0..NPAIR {
-                    let val = x[kk][l] + x[l][kk];
-                    for i in 0..3 {
-                        out.tangent[(3 * kk + i) * NDOF + 3 * l + i] += val;
-                    }
-                    if split {
-                        for i in 0..3 {
-                            out.preconditioner[(3 * kk + i) * NDOF + 3 * l + i] += val;
-                        }
-                    }
-                }
+            add_geometric_stiffness(&x, &mut out.tangent);
+            if split {
+                add_geometric_stiffness(&x, &mut out.preconditioner);
             }
         }
     }

@@ -126,3 +126,19 @@ pub fn axpy<const D: usize>(y: &mut [f64; D], a: f64, x: &[f64; D]) {
         *yi += a * xi;
     }
 }
+
+/// m += (X + X^T) (x) I3: the geometric stiffness sum_s mu_s scale_s (a_s b_s^T + b_s a_s^T) (x) I3
+/// of the samples, gathered in X = sum_s mu_s scale_s a_s b_s^T over the P (node, surface) pairs,
+/// added into a row-major 3P x 3P matrix.
+#[inline(always)]
+pub fn add_geometric_stiffness<const P: usize>(x: &[[f64; P]; P], m: &mut [f64]) {
+    let d = 3 * P;
+    for k in 0..P {
+        for l in 0..P {
+            let val = x[k][l] + x[l][k];
+            for i in 0..3 {
+                m[(3 * k + i) * d + 3 * l + i] += val;
+            }
+        }
+    }
+}
