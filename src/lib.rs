@@ -12,6 +12,7 @@ pub mod io;
 pub mod mesh;
 pub mod mesh_check;
 pub mod mesh_refine;
+pub mod mesh_transfer;
 pub mod surface;
 
 pub use error::{quote, Result, StampError};
@@ -23,3 +24,4 @@ pub mod contact;
 pub mod follower;
 pub mod model;
 pub mod nonlinear;
+pub mod coarse_path;

@@ -360,6 +360,11 @@ impl<E: Element> NonlinearProblem for Model<E> {
             c.start_step();
         }
     }
+    fn start_predicted(&mut self, predicted: bool) {
+        for c in self.contacts.iter_mut() {
+            c.start_predicted(predicted);
+        }
+    }
     /// The augmented-Lagrangian update of [`end_step`](Self::end_step), at the last evaluation's
     /// iterate (Newton calls it before it converged, see [`crate::nonlinear::NewtonSettings::multiplier_tol`]).
     fn update_multipliers(&mut self) -> bool {

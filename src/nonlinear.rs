@@ -59,6 +59,11 @@ pub trait NonlinearProblem {
     }
     /// Called before the first iteration of every load step.
     fn start_step(&mut self) {}
+    /// Called after [`start_step`](Self::start_step) with true when the step starts from an
+    /// outside prediction of its answer ([`NewtonRaphson::predictor`]: the solution on a coarse
+    /// mesh) rather than from the extrapolated path: the problem may trust the start (the contact
+    /// pairs then let every penetrating point into the active set at once).
+    fn start_predicted(&mut self, _predicted: bool) {}
     /// Called after a load step converged. Returning true asks for the step to be solved again at
     /// the same load (an augmented-Lagrangian update, say).
     fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
@@ -283,11 +288,17 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// Set (by the step callback, say, after its output failed) to end the path after the current
     /// step: `solve_path` then returns [`StampError::Problem`] "stopped on request".
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// The start of each load step, when given: called with (converged steps so far, load factor
+    /// of the last converged state, load factor of the step, the start to set); true when it set
+    /// the start (then used instead of the secant extrapolation, see
+    /// [`NonlinearProblem::start_predicted`]), false to keep the extrapolation. A
+    /// [`crate::coarse_path::CoarsePath`], say.
+    pub predictor: Option<Box<dyn FnMut(usize, f64, f64, &mut [f64]) -> bool>>,
 }
 
 impl<L: LinearSolver> NewtonRaphson<L> {
     pub fn new(linear: L, settings: NewtonSettings) -> Self {
-        NewtonRaphson { settings, linear, on_iteration: None, stop: None }
+        NewtonRaphson { settings, linear, on_iteration: None, stop: None, predictor: None }
     }
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
@@ -537,8 +548,10 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         }
                     }
                 }
+                let predicted = self.predictor.as_mut().is_some_and(|predict| predict(summary.steps, t, step_t, &mut trial));
                 p.apply_prescribed(&mut trial, step_t);
                 p.start_step();
+                p.start_predicted(predicted);
                 // multiplier updates of this attempt, inside Newton and by re-solves
                 let mut updates = 0;
                 // iterations of the re-solves of this step before the last one
@@ -708,6 +721,35 @@ mod tests {
 
     fn settings() -> NewtonSettings {
         NewtonSettings { max_increment: 0.25, max_cutbacks: 2, ..NewtonSettings::default() }
+    }
+
+    /// A predictor that hits the answer (u = t) starts every step converged: no iteration; it
+    /// sees each step's start and end load factors, with the converged steps so far, and a step
+    /// it declines (false) starts from the secant extrapolation.
+    #[test]
+    fn a_predictor_that_hits_the_answer_saves_every_iteration() {
+        let mut newton = NewtonRaphson::new(SparseLu::new(), settings());
+        let calls = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let seen = calls.clone();
+        newton.predictor = Some(Box::new(move |steps, from, to, u| {
+            seen.borrow_mut().push((steps, from, to));
+            u[0] = to;
+            true
+        }));
+        let mut p = Line::new();
+        let mut u = vec![0.0];
+        let mut iterations = Vec::new();
+        newton.solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |r, _, _| iterations.push(r.iterations)).unwrap();
+        assert_eq!(iterations, vec![0; 4], "four steps of 0.25, each started at its answer");
+        assert_eq!(*calls.borrow(), vec![(0, 0.0, 0.25), (1, 0.25, 0.5), (2, 0.5, 0.75), (3, 0.75, 1.0)]);
+        assert!((u[0] - 1.0).abs() < 1e-12);
+        // declined: the first step starts from u = 0 (one iteration), the others from the exact
+        // secant of the linear path
+        newton.predictor = Some(Box::new(|_, _, _, _| false));
+        let mut u = vec![0.0];
+        let mut iterations = Vec::new();
+        newton.solve_path(&mut Line::new(), &mut u, 0.0, &[1.0], &mut |r, _, _| iterations.push(r.iterations)).unwrap();
+        assert_eq!(iterations[0], 1);
     }
 
     #[test]
