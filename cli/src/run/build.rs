@@ -32,7 +32,7 @@
 
 use super::mesh::{group_error, MeshData};
 use super::plate_model::{Layout, Plate};
-use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Problem, PunchFace, Shape};
+use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape};
 use nalgebra::Vector3;
 use stamp::contact::{automatic_eps_reg, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
@@ -66,6 +66,9 @@ pub struct Setup {
     pub punches: Vec<PunchInfo>,
     pub targets: Vec<f64>,
     pub settings: NewtonSettings,
+    /// `[solver] predictor = "coarse"`: the same problem on the coarse mesh (solved first, see
+    /// super::coarse); None otherwise, and on the meshes of `--refine`.
+    pub coarse: Option<Box<Setup>>,
 }
 
 fn face_of(f: PunchFace) -> Face {
@@ -145,7 +148,39 @@ pub fn build(p: &Problem) -> Result<Setup> {
         Some(file) => super::memory::check_model_fits(mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(file.span(), "mesh.file", m))?,
         None => super::memory::check_model_fits(mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(s.mesh.span(), "mesh.rectangle", m))?,
     }
-    build_on(p, mesh)
+    let mut setup = build_on(p, mesh)?;
+    if s.solver.predictor.as_ref().is_some_and(|k| *k.get_ref() == Predictor::Coarse) {
+        setup.coarse = Some(Box::new(build_coarse(p, &setup.mesh)?));
+    }
+    Ok(setup)
+}
+
+/// The problem on the coarse mesh of `predictor = "coarse"`; its errors say that they are the
+/// coarse mesh's (a group the coarse file lacks, a rectangle too coarse for a `center`).
+fn build_coarse(p: &Problem, fine: &MeshData) -> Result<Setup> {
+    let key = p.spec.solver.predictor.as_ref().map(|k| k.span()).unwrap_or_else(|| p.spec.mesh.span());
+    let (what, span) = match &p.spec.mesh.get_ref().coarse_file {
+        Some(f) => (format!("the coarse mesh {}", f.get_ref()), f.span()),
+        None => {
+            let r = p.spec.mesh.get_ref().rectangle.as_ref().expect("checked: file or rectangle");
+            (format!("the coarse mesh (the rectangle with n = [{}, {}])", r.n[0] / 2, r.n[1] / 2), key)
+        }
+    };
+    let coarse = MeshData::load_coarse(p).map_err(|e| match e {
+        StampError::Mesh(m) => p.error_at(span.clone(), "mesh.coarse_file", m),
+        e => e,
+    })?;
+    if coarse.mesh.num_nodes() >= fine.mesh.num_nodes() {
+        return Err(p.error_at(
+            span,
+            "mesh.coarse_file",
+            format!("{what} has {} nodes, the mesh {}: the coarse mesh must have fewer", coarse.mesh.num_nodes(), fine.mesh.num_nodes()),
+        ));
+    }
+    build_on(p, coarse).map_err(|e| match e {
+        StampError::Input { file, message } => StampError::Input { file, message: format!("{message} (on {what} of [solver] predictor = \"coarse\")") },
+        e => StampError::Problem(format!("{what} of [solver] predictor = \"coarse\": {e}")),
+    })
 }
 
 /// Build everything the solve needs on the given mesh (the problem's own, or its refinement: the
@@ -417,7 +452,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         settings.cycling_after = x.0;
     }
     settings.validate().map_err(|e| StampError::Input { file: p.path.display().to_string(), message: format!("[solver]: {e}") })?;
-    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings })
+    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, coarse: None })
 }
 
 /// The STL die of a punch: `file` relative to the problem file; errors name the problem file, the

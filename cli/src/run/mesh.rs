@@ -10,6 +10,7 @@ use stamp::io::read_msh;
 use stamp::mesh::QuadMesh;
 use stamp::{Result, StampError};
 use std::collections::BTreeMap;
+use toml::Spanned;
 
 /// A mesh and its named groups.
 pub struct MeshData {
@@ -34,46 +35,66 @@ impl MeshData {
     pub fn load(p: &Problem) -> Result<MeshData> {
         let spec = p.spec.mesh.get_ref();
         if let Some(file) = &spec.file {
-            let path = p.dir().join(file.get_ref());
-            if !path.exists() {
-                return Err(p.error_at(file.span(), "mesh.file", format!("{} does not exist", path.display())));
-            }
-            let g = read_msh(&path)?;
-            let surfaces = g.mesh.cell_groups.clone();
-            let split = g.split_summary();
-            Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh, split })
+            Self::read(p, file, "mesh.file")
         } else {
             let r = spec.rectangle.as_ref().expect("checked: file or rectangle");
-            let (nx, ny) = (r.n[0], r.n[1]);
-            let mut mesh = QuadMesh::rectangle(r.x[0], r.x[1], r.y[0], r.y[1], nx, ny)?;
-            let id = |i: usize, j: usize| j * (nx + 1) + i;
-            let mut curves = BTreeMap::new();
-            let chain = |nodes: Vec<usize>| nodes.windows(2).map(|w| [w[0], w[1]]).collect::<Vec<_>>();
-            curves.insert("bottom".to_string(), chain((0..=nx).map(|i| id(i, 0)).collect()));
-            curves.insert("right".to_string(), chain((0..=ny).map(|j| id(nx, j)).collect()));
-            curves.insert("top".to_string(), chain((0..=nx).rev().map(|i| id(i, ny)).collect()));
-            curves.insert("left".to_string(), chain((0..=ny).rev().map(|j| id(0, j)).collect()));
-            let boundary: Vec<[usize; 2]> = ["bottom", "right", "top", "left"].iter().flat_map(|k| curves[*k].clone()).collect();
-            curves.insert("boundary".to_string(), boundary);
-            let mut points = BTreeMap::new();
-            points.insert("corner_ll".to_string(), vec![id(0, 0)]);
-            points.insert("corner_lr".to_string(), vec![id(nx, 0)]);
-            points.insert("corner_ur".to_string(), vec![id(nx, ny)]);
-            points.insert("corner_ul".to_string(), vec![id(0, ny)]);
-            if nx % 2 == 0 && ny % 2 == 0 {
-                points.insert("center".to_string(), vec![id(nx / 2, ny / 2)]);
-            }
-            let mut bnodes: Vec<usize> = curves["boundary"].iter().flatten().copied().collect();
-            bnodes.sort_unstable();
-            bnodes.dedup();
-            mesh.node_groups.insert("boundary".into(), bnodes);
-            mesh.node_groups.insert("all".into(), (0..mesh.num_nodes()).collect());
-            for (k, v) in &points {
-                mesh.node_groups.insert(k.clone(), v.clone());
-            }
-            let surfaces = mesh.cell_groups.clone();
-            Ok(MeshData { mesh, points, curves, surfaces, node_tags: None, cell_tags: None, split: None })
+            Self::rectangle(r, r.n[0], r.n[1])
         }
+    }
+
+    /// The coarse mesh of `[solver] predictor = "coarse"`: the rectangle with half its n (checked
+    /// even), or `mesh.coarse_file`. Errors name the coarse file.
+    pub fn load_coarse(p: &Problem) -> Result<MeshData> {
+        let spec = p.spec.mesh.get_ref();
+        match (&spec.rectangle, &spec.coarse_file) {
+            (Some(r), _) => Self::rectangle(r, r.n[0] / 2, r.n[1] / 2),
+            (None, Some(file)) => Self::read(p, file, "mesh.coarse_file"),
+            (None, None) => Err(p.error_at(p.spec.mesh.span(), "mesh.coarse_file", "is needed for predictor = \"coarse\" with a gmsh mesh")),
+        }
+    }
+
+    /// The gmsh file `file` (given at `key`), relative to the problem file.
+    fn read(p: &Problem, file: &Spanned<String>, key: &str) -> Result<MeshData> {
+        let path = p.dir().join(file.get_ref());
+        if !path.exists() {
+            return Err(p.error_at(file.span(), key, format!("{} does not exist", path.display())));
+        }
+        let g = read_msh(&path)?;
+        let surfaces = g.mesh.cell_groups.clone();
+        let split = g.split_summary();
+        Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh, split })
+    }
+
+    /// The built-in rectangle `r` with nx x ny cells and its named groups.
+    fn rectangle(r: &super::problem::RectangleSpec, nx: usize, ny: usize) -> Result<MeshData> {
+        let mut mesh = QuadMesh::rectangle(r.x[0], r.x[1], r.y[0], r.y[1], nx, ny)?;
+        let id = |i: usize, j: usize| j * (nx + 1) + i;
+        let mut curves = BTreeMap::new();
+        let chain = |nodes: Vec<usize>| nodes.windows(2).map(|w| [w[0], w[1]]).collect::<Vec<_>>();
+        curves.insert("bottom".to_string(), chain((0..=nx).map(|i| id(i, 0)).collect()));
+        curves.insert("right".to_string(), chain((0..=ny).map(|j| id(nx, j)).collect()));
+        curves.insert("top".to_string(), chain((0..=nx).rev().map(|i| id(i, ny)).collect()));
+        curves.insert("left".to_string(), chain((0..=ny).rev().map(|j| id(0, j)).collect()));
+        let boundary: Vec<[usize; 2]> = ["bottom", "right", "top", "left"].iter().flat_map(|k| curves[*k].clone()).collect();
+        curves.insert("boundary".to_string(), boundary);
+        let mut points = BTreeMap::new();
+        points.insert("corner_ll".to_string(), vec![id(0, 0)]);
+        points.insert("corner_lr".to_string(), vec![id(nx, 0)]);
+        points.insert("corner_ur".to_string(), vec![id(nx, ny)]);
+        points.insert("corner_ul".to_string(), vec![id(0, ny)]);
+        if nx % 2 == 0 && ny % 2 == 0 {
+            points.insert("center".to_string(), vec![id(nx / 2, ny / 2)]);
+        }
+        let mut bnodes: Vec<usize> = curves["boundary"].iter().flatten().copied().collect();
+        bnodes.sort_unstable();
+        bnodes.dedup();
+        mesh.node_groups.insert("boundary".into(), bnodes);
+        mesh.node_groups.insert("all".into(), (0..mesh.num_nodes()).collect());
+        for (k, v) in &points {
+            mesh.node_groups.insert(k.clone(), v.clone());
+        }
+        let surfaces = mesh.cell_groups.clone();
+        Ok(MeshData { mesh, points, curves, surfaces, node_tags: None, cell_tags: None, split: None })
     }
 
     /// The uniform refinement of this mesh ([`stamp::mesh_refine`]: every cell into four at its edge

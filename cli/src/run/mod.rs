@@ -13,6 +13,7 @@
 //! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in [`crate::paper`]).
 
 pub mod build;
+pub mod coarse;
 pub mod check;
 pub mod history;
 pub mod memory;

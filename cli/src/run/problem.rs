@@ -338,6 +338,10 @@ pub struct MeshSpec {
     /// Built-in structured mesh.
     #[serde(default)]
     pub rectangle: Option<RectangleSpec>,
+    /// With `[solver] predictor = "coarse"` and a gmsh `file`: the coarse mesh of the same plate
+    /// (the same physical groups), relative to the problem file.
+    #[serde(default)]
+    pub coarse_file: Option<Spanned<String>>,
 }
 
 /// The built-in rectangle, checked while deserialising: finite increasing intervals with a finite
@@ -627,6 +631,21 @@ pub struct SolverSpec {
     /// iteration on, and cut it back (off by default; see NewtonSettings::cycling_after).
     #[serde(default)]
     pub cycling_after: Option<CycleCount>,
+    /// Where each load step starts (default "secant").
+    #[serde(default)]
+    pub predictor: Option<Spanned<Predictor>>,
+}
+
+/// `[solver] predictor`: the start of each load step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Predictor {
+    /// The last converged increment again (scaled to the step).
+    #[default]
+    Secant,
+    /// The problem solved first on a coarse mesh (the rectangle with half its n, or
+    /// `mesh.coarse_file`), interpolated onto the mesh (stamp::coarse_path).
+    Coarse,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -875,6 +894,26 @@ impl Problem {
             if r.n[0] == 0 || r.n[1] == 0 {
                 return Err(self.error_at(s.mesh.span(), "mesh.rectangle.n", format!("needs at least one cell each way, got {:?}", r.n)));
             }
+        }
+        let coarse = s.solver.predictor.as_ref().filter(|k| *k.get_ref() == Predictor::Coarse);
+        match (&mesh.rectangle, &mesh.coarse_file, coarse) {
+            (Some(_), Some(f), _) => {
+                return Err(self.error_at(f.span(), "mesh.coarse_file", "belongs to a gmsh `file`: with `rectangle`, predictor = \"coarse\" halves its n"));
+            }
+            (None, Some(f), None) => {
+                return Err(self.error_at(f.span(), "mesh.coarse_file", "is read only with [solver] predictor = \"coarse\""));
+            }
+            (None, None, Some(k)) => {
+                return Err(self.error_at(k.span(), "solver.predictor", "\"coarse\" with a gmsh mesh needs [mesh] coarse_file: the same plate meshed coarser, with the same physical groups"));
+            }
+            (Some(r), None, Some(k)) if r.n[0] % 2 == 1 || r.n[1] % 2 == 1 || r.n[0] < 2 || r.n[1] < 2 => {
+                return Err(self.error_at(
+                    k.span(),
+                    "solver.predictor",
+                    format!("\"coarse\" solves first on the rectangle with half its n: mesh.rectangle.n = {:?} must be even numbers", r.n),
+                ));
+            }
+            _ => {}
         }
         let plate = s.plate.get_ref();
         match (plate.thickness, plate.delta_minus, plate.delta_plus) {

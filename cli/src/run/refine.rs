@@ -17,7 +17,7 @@ use super::build::{build, build_on};
 use super::mesh::MeshData;
 use super::problem::Problem;
 use super::refine_report::{quantities, times, Report};
-use super::solve::{default_out_dir, solve_and_write, RunOutcome, SolveOptions};
+use super::solve::{default_out_dir, solve_and_write, PreviousLevel, RunOutcome, SolveOptions};
 use super::units::Units;
 use serde_json::{json, Value};
 use stamp::io::write_string_atomically;
@@ -110,7 +110,8 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     };
 
     let running = refinement("solving the problem's mesh".into(), &meshes);
-    let opts = SolveOptions { quiet, no_table: true, targets: None, refinement: Some(running), caller_finishes: true };
+    let mut previous_mesh = setup.mesh.mesh.clone();
+    let opts = SolveOptions { quiet, no_table: true, targets: None, refinement: Some(running), caller_finishes: true, record_states: true, previous: None };
     let coarse = solve_and_write(&p, setup, &out_dir, &opts);
     for w in super::check::never_touched(&p, &out_dir.join("summary.json")) {
         eprintln!("warning: {w}");
@@ -125,6 +126,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     let load_factors: Vec<f64> = coarse.history.rows.iter().map(|r| r.load_factor).collect();
     let mut fines = Vec::with_capacity(levels);
     let mut files = coarse.files.clone();
+    let mut previous_states = std::sync::Arc::new(coarse.states.clone());
     for level in 1..=levels {
         let mesh = next.take().expect("refined before the loop or in the level before");
         if level < levels {
@@ -137,13 +139,16 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         if !quiet {
             eprintln!("stamp run --refine: {status}");
         }
+        let this_mesh = mesh.mesh.clone();
         let fine = build_on(&p, mesh).and_then(|setup| {
-            let note = json!({ "level": level, "note": format!("the problem's mesh refined {}, driven through the load factors of ../summary.json", times(level)) });
-            let opts = SolveOptions { quiet, no_table: true, targets: Some(load_factors.clone()), refinement: Some(note), caller_finishes: false };
+            let note = json!({ "level": level, "note": format!("the problem's mesh refined {}, driven through the load factors of ../summary.json, every step started from the solution on the mesh before", times(level)) });
+            let previous = PreviousLevel { mesh: std::mem::replace(&mut previous_mesh, this_mesh), states: previous_states.clone() };
+            let opts = SolveOptions { quiet, no_table: true, targets: Some(load_factors.clone()), refinement: Some(note), caller_finishes: false, record_states: level < levels, previous: Some(previous) };
             solve_and_write(&p, setup, &dir, &opts)
         });
         match fine {
             Ok(f) => {
+                previous_states = std::sync::Arc::new(f.states);
                 files.extend(f.files.iter().cloned());
                 fines.push(f.history);
             }

@@ -29,6 +29,17 @@ pub struct RunOutcome {
     pub files: Vec<PathBuf>,
     /// The converged steps' punch forces, travels and deflections.
     pub history: History,
+    /// The converged states (load factor, unknowns) of every step, with
+    /// [`SolveOptions::record_states`] (empty otherwise).
+    pub states: Vec<(f64, Vec<f64>)>,
+}
+
+/// A run on a coarser mesh whose converged states start every load step of this one (`stamp run
+/// --refine`: the mesh before).
+#[derive(Debug, Clone)]
+pub struct PreviousLevel {
+    pub mesh: stamp::mesh::QuadMesh,
+    pub states: Arc<Vec<(f64, Vec<f64>)>>,
 }
 
 /// How [`solve_and_write`] runs beyond the problem file.
@@ -46,6 +57,11 @@ pub struct SolveOptions {
     pub refinement: Option<Value>,
     /// The caller finishes summary.json after a converged run: its status stays "running".
     pub caller_finishes: bool,
+    /// Keep every converged state in [`RunOutcome::states`].
+    pub record_states: bool,
+    /// Start every load step from this run's solution (interpolated onto this mesh) instead of
+    /// the secant predictor, or the `[solver] predictor = "coarse"` solve.
+    pub previous: Option<PreviousLevel>,
 }
 
 #[derive(Serialize)]
@@ -94,6 +110,10 @@ struct Summary {
     seconds: f64,
     point_arrays: Vec<String>,
     cell_arrays: Vec<String>,
+    /// `[solver] predictor = "coarse"`: what the coarse solve cost (see coarse.rs); absent
+    /// otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    coarse_predictor: Option<super::coarse::CoarseReport>,
     /// `stamp run --refine`: the meshes and the estimates (see refine.rs); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     refinement: Option<Value>,
@@ -224,7 +244,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
     // removes the previous run's files; records this run's when dropped (see out_dir.rs)
     let _folder = super::out_dir::RunFolder::claim(out_dir)?;
-    let Setup { mesh, mut model, section, punches, targets, settings } = setup;
+    let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
     let targets = opts.targets.clone().unwrap_or(targets);
     let out = &p.spec.output;
     let stem = p.path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "step".into());
@@ -304,6 +324,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         seconds: 0.0,
         point_arrays: super::output::POINT_ARRAYS.iter().filter(|n| **n != "gap" || !punches.is_empty()).map(|s| s.to_string()).collect(),
         cell_arrays: super::output::CELL_ARRAYS.iter().map(|s| s.to_string()).collect(),
+        coarse_predictor: None,
         refinement: opts.refinement.clone(),
         steps: Vec::new(),
     };
@@ -320,6 +341,26 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
     // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
     let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
+    if let Some(previous) = &opts.previous {
+        let mut path = stamp::coarse_path::CoarsePath::new(stamp::mesh_transfer::Prolongation::between(&previous.mesh, &mesh.mesh), model.dofs.dofs_per_node());
+        // the path starts unloaded (prescribed values scale with the load factor)
+        path.record(0.0, &vec![0.0; previous.states.first().map(|s| s.1.len()).unwrap_or(0)]);
+        for (t, u) in previous.states.iter() {
+            path.record(*t, u);
+        }
+        super::coarse::predict_from(&mut newton, path);
+    } else if let Some(coarse) = coarse {
+        if !quiet {
+            eprintln!("coarse predictor: solving on the coarse mesh ({} nodes) first", coarse.mesh.mesh.num_nodes());
+        }
+        let (path, report) = super::coarse::solve_coarse(*coarse, &mesh, &targets);
+        if !quiet || report.error.is_some() {
+            eprintln!("{}", report.line());
+        }
+        super::coarse::predict_from(&mut newton, path);
+        summary.coarse_predictor = Some(report);
+        write_summary(&summary_path, &summary, None)?;
+    }
     newton.on_iteration = progress.callback();
     // a failed output write ends the run after its step (what follows could not be written)
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -327,8 +368,12 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let mut surface_error: Option<StampError> = None;
+    let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
     let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
         total_iterations += rep.iterations;
+        if opts.record_states {
+            states.push((rep.load_factor, u.to_vec()));
+        }
         // a punch whose Psi was not finite somewhere (an expression's sqrt of a negative number)
         // stops the run: its answer would be wrong
         if surface_error.is_none() {
@@ -477,6 +522,6 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let converged_steps = summary.steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).count();
     match failure {
         Some(e) => Err(e),
-        None => Ok(RunOutcome { out_dir: out_dir.to_path_buf(), summary: summary_path, converged_steps, files, history }),
+        None => Ok(RunOutcome { out_dir: out_dir.to_path_buf(), summary: summary_path, converged_steps, files, history, states }),
     }
 }

@@ -1,0 +1,131 @@
+//! `[solver] predictor = "coarse"` and `stamp run --refine`: load steps started from the solution
+//! on a coarser mesh give the answer of the secant predictor (the same converged equations) in
+//! fewer Newton iterations, on the built-in rectangle (the coarse mesh nested in it) and on two
+//! independent gmsh meshes of a curved plate; summary.json reports the coarse solve; bad
+//! combinations of keys are refused with the file, the line and the key.
+
+mod common;
+use common::*;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// `stamp run -q` into `out`; (exit code, stderr).
+fn stamp_run(problem: &Path, out: &Path, extra: &[&str]) -> (Option<i32>, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("run").args(extra).args(["-q", "--out"]).arg(out).arg(problem).output().unwrap();
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// Run `problem` into a fresh folder `name` and return it (the run must converge).
+fn run(problem: &Path, name: &str) -> PathBuf {
+    let out = temp_dir(name);
+    let (code, err) = stamp_run(problem, &out, &[]);
+    assert_eq!(code, Some(0), "{}: {err}", problem.display());
+    out
+}
+
+/// (punch force, Newton iterations) of every converged step of summary.json.
+fn steps(out: &Path) -> Vec<(f64, usize)> {
+    summary(out)["steps"].as_array().unwrap().iter().map(|s| (-s["reaction"][2].as_f64().unwrap(), s["newton_iterations"].as_u64().unwrap() as usize)).collect()
+}
+
+/// Same forces at every step (to `tol` relative); the total Newton iterations of `a` and `b`.
+fn same_forces(a: &[(f64, usize)], b: &[(f64, usize)], tol: f64) -> (usize, usize) {
+    assert_eq!(a.len(), b.len());
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        assert!(x.0 > 0.0 && (x.0 - y.0).abs() <= tol * x.0, "step {}: force {} against {}", k + 1, x.0, y.0);
+    }
+    (a.iter().map(|s| s.1).sum(), b.iter().map(|s| s.1).sum())
+}
+
+#[test]
+fn the_rectangle_with_half_its_n_starts_every_step_and_saves_iterations() {
+    // meshes/sphere-ss-displacement.toml on 40 x 40 (measured: 35 Newton iterations with the
+    // secant predictor, 29 from the 20 x 20 mesh's solution, which took 40 of its own)
+    let n40 = [("n = [10, 10]", "n = [40, 40]"), ("plot = true", "plot = false")];
+    let secant = run(&variant("coarse-off", "sphere-ss-displacement.toml", &n40), "coarse-off-out");
+    let mut edits = n40.to_vec();
+    edits.push(("line_search_steps = 4", "line_search_steps = 4\npredictor = \"coarse\""));
+    let coarse = run(&variant("coarse-on", "sphere-ss-displacement.toml", &edits), "coarse-on-out");
+    let (a, b) = same_forces(&steps(&secant), &steps(&coarse), 1e-7);
+    assert!(b < a, "{b} Newton iterations from the coarse mesh against {a} from the secant predictor");
+    let s = summary(&coarse);
+    let c = &s["coarse_predictor"];
+    assert_eq!(c["nodes"], 21 * 21, "{c}");
+    assert_eq!(c["steps"], 5);
+    assert_eq!(c["reached_load_factor"], 1.0);
+    assert!(c["error"].is_null() && c["newton_iterations"].as_u64().unwrap() > 0, "{c}");
+    assert_eq!(s["status"], "converged");
+    assert!(summary(&secant).get("coarse_predictor").is_none());
+}
+
+#[test]
+fn two_independent_gmsh_meshes_of_a_curved_plate() {
+    // meshes/disk-clamped.toml on gmsh's lc = 1 triangles, started from the shipped lc = 2 mesh:
+    // neither nested nor with the same boundary (the arc's chords differ), measured 54 Newton
+    // iterations with the secant predictor against 25
+    let fine = [("file = \"disk-clamped.msh\"", "file = \"disk-clamped-lc1.msh\"")];
+    let secant = run(&variant("disk-secant", "disk-clamped.toml", &fine), "disk-secant-out");
+    let coarse = variant(
+        "disk-coarse",
+        "disk-clamped.toml",
+        &[("file = \"disk-clamped.msh\"", "file = \"disk-clamped-lc1.msh\"\ncoarse_file = \"disk-clamped.msh\""), ("[solver]", "[solver]\npredictor = \"coarse\"")],
+    );
+    let coarse = run(&coarse, "disk-coarse-out");
+    let (a, b) = same_forces(&steps(&secant), &steps(&coarse), 1e-7);
+    assert!(2 * b < a + 10, "{b} Newton iterations from the coarse mesh against {a} from the secant predictor");
+    assert_eq!(summary(&coarse)["coarse_predictor"]["nodes"], summary(&run(&repo().join("meshes/disk-clamped.toml"), "disk-shipped"))["nodes"]);
+}
+
+#[test]
+fn refine_starts_every_finer_mesh_from_the_one_before() {
+    // --refine 2 from 10 x 10: its 20 x 20 and 40 x 40 runs give what plain runs on those meshes
+    // give, in fewer iterations (measured 36 and 29 against 40 and 35)
+    let problem = variant("refine-nested", "sphere-ss-displacement.toml", &[("plot = true", "plot = false")]);
+    let out = temp_dir("refine-nested-out");
+    let (code, err) = stamp_run(&problem, &out, &["--refine=2"]);
+    assert_eq!(code, Some(0), "{err}");
+    for (level, n) in [("refined", 20), ("refined2", 40)] {
+        let plain = variant(&format!("plain-{n}"), "sphere-ss-displacement.toml", &[("n = [10, 10]", &format!("n = [{n}, {n}]")), ("plot = true", "plot = false")]);
+        let plain = run(&plain, &format!("plain-{n}-out"));
+        let (a, b) = same_forces(&steps(&plain), &steps(&out.join(level)), 1e-7);
+        assert!(b < a, "{level}: {b} Newton iterations from the mesh before against {a} from the secant predictor");
+        let note = summary(&out.join(level))["refinement"]["note"].as_str().unwrap().to_string();
+        assert!(note.contains("started from the solution on the mesh before"), "{note}");
+    }
+}
+
+/// `stamp run` and `stamp check` refuse `text` (written as `case`.toml beside the shipped meshes)
+/// naming the file, "line L" of the line containing `at`, and every one of `wanted`.
+fn refused(case: &str, shipped: &str, edits: &[(&str, &str)], at: &str, wanted: &[&str]) {
+    let path = variant(case, shipped, edits);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let line = text.lines().position(|l| l.contains(at)).unwrap_or_else(|| panic!("{at} not in {case}")) + 1;
+    let (code, err) = stamp_run(&path, &path.with_extension("out"), &[]);
+    let check = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(&path).output().unwrap();
+    let check_err = String::from_utf8_lossy(&check.stderr).into_owned();
+    for (what, code, err) in [("run", code, &err), ("check", check.status.code(), &check_err)] {
+        assert_eq!(code, Some(1), "{case} ({what}): {err}");
+        assert!(err.contains(&format!("{case}.toml: line {line},")), "{case} ({what}): not at line {line}: {err}");
+        for w in wanted {
+            assert!(err.contains(w), "{case} ({what}): no '{w}' in: {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn bad_combinations_are_refused_with_the_key_and_the_line() {
+    let coarse = ("line_search_steps = 4", "line_search_steps = 4\npredictor = \"coarse\"");
+    refused("odd-n", "sphere-ss-displacement.toml", &[("n = [10, 10]", "n = [9, 10]"), coarse], "predictor", &["solver.predictor", "[9, 10]", "even"]);
+    refused("unknown-predictor", "sphere-ss-displacement.toml", &[("line_search_steps = 4", "line_search_steps = 4\npredictor = \"quadratic\"")], "predictor", &["predictor", "`secant` or `coarse`"]);
+    refused("rectangle-coarse-file", "sphere-ss-displacement.toml", &[("n = [10, 10] }", "n = [10, 10] }\ncoarse_file = \"disk-clamped.msh\""), coarse], "coarse_file", &["mesh.coarse_file", "rectangle"]);
+    // a gmsh mesh: the coarse file is needed, read only with the predictor, must exist, must hold
+    // the groups the problem names, and must be coarser
+    let gmsh = ("[solver]", "[solver]\npredictor = \"coarse\"");
+    let file = "file = \"disk-clamped.msh\"";
+    refused("no-coarse-file", "disk-clamped.toml", &[gmsh], "predictor", &["solver.predictor", "coarse_file"]);
+    refused("coarse-file-alone", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"disk-clamped.msh\"")], "coarse_file", &["mesh.coarse_file", "predictor = \"coarse\""]);
+    refused("coarse-file-missing", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"nothere.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "nothere.msh", "does not exist"]);
+    refused("coarse-file-groups", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"paper-r100.msh\""), gmsh], "group = \"left\"", &["boundary[0].group", "'left'", "coarse mesh paper-r100.msh"]);
+    refused("coarse-file-finer", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"disk-clamped-lc1.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "2359 nodes", "fewer"]);
+}
