@@ -70,9 +70,22 @@ impl BenchProblem {
     }
 }
 
+/// Where each load step of [`BenchProblem::SphereDisplacement`] starts: `[solver] predictor`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BenchPredictor {
+    /// The problem file's own: the secant predictor (the last converged increment again).
+    #[default]
+    Secant,
+    /// The solution on the mesh with half the n, interpolated (`predictor = "coarse"`).
+    Coarse,
+}
+
 /// The problem file of [`BenchProblem::SphereDisplacement`], its mesh line as in the file.
 const DISPLACEMENT_PROBLEM: &str = include_str!("../../meshes/sphere-ss-displacement.toml");
 const DISPLACEMENT_MESH_N: &str = "n = [10, 10]";
+/// Its [solver] table's header, after which `--predictor coarse` adds its key.
+const DISPLACEMENT_SOLVER: &str = "[solver]\n";
 
 /// Seconds spent in each phase.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
@@ -111,6 +124,19 @@ pub struct BenchRun {
     /// same problem at every size, so these converge with n.
     pub centre_deflection: f64,
     pub reaction: f64,
+    /// `[solver] predictor = "coarse"` (the sphere-displacement problem file): the coarse solve
+    /// that started every step, included in `seconds.total`.
+    #[serde(default)]
+    pub coarse: Option<CoarseRun>,
+}
+
+/// The coarse solve of a run with `predictor = "coarse"`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CoarseRun {
+    pub unknowns: usize,
+    pub steps: usize,
+    pub newton_iterations: usize,
+    pub seconds: f64,
 }
 
 /// Build the quarter model on an n x n mesh.
@@ -177,13 +203,18 @@ pub struct SolverOptions {
     pub symmetric_part: bool,
     /// The problem solved.
     pub problem: BenchProblem,
+    /// Where each load step starts (sphere-displacement only).
+    pub predictor: BenchPredictor,
 }
 
 /// The model, the load targets and the settings of `meshes/sphere-ss-displacement.toml` on an
 /// n x n mesh, built as `stamp run` builds them.
-fn build_displacement(n: usize) -> Result<(crate::run::build::Setup, Vec<f64>)> {
-    debug_assert!(DISPLACEMENT_PROBLEM.contains(DISPLACEMENT_MESH_N));
-    let source = DISPLACEMENT_PROBLEM.replacen(DISPLACEMENT_MESH_N, &format!("n = [{n}, {n}]"), 1);
+fn build_displacement(n: usize, predictor: BenchPredictor) -> Result<(crate::run::build::Setup, Vec<f64>)> {
+    debug_assert!(DISPLACEMENT_PROBLEM.contains(DISPLACEMENT_MESH_N) && DISPLACEMENT_PROBLEM.contains(DISPLACEMENT_SOLVER));
+    let mut source = DISPLACEMENT_PROBLEM.replacen(DISPLACEMENT_MESH_N, &format!("n = [{n}, {n}]"), 1);
+    if predictor == BenchPredictor::Coarse {
+        source = source.replacen(DISPLACEMENT_SOLVER, &format!("{DISPLACEMENT_SOLVER}predictor = \"coarse\"\n"), 1);
+    }
     let p = crate::run::Problem::parse(std::path::Path::new("meshes/sphere-ss-displacement.toml"), source)?;
     let setup = crate::run::build::build(&p)?;
     let targets = setup.targets.clone();
@@ -196,16 +227,31 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
     if n == 0 {
         return Err(StampError::Problem("bench sizes must be positive".into()));
     }
+    check_predictor(options)?;
+    if options.predictor == BenchPredictor::Coarse && n % 2 == 1 {
+        return Err(StampError::Problem(format!("--predictor coarse solves first on the mesh with half the n: n = {n} must be even")));
+    }
     let start = Instant::now();
-    let (mut model, mesh, settings, targets) = match options.problem {
-        BenchProblem::Sphere => (build(n)?, QuadMesh::rectangle(0.0, 0.5 * SIDE, 0.0, 0.5 * SIDE, n, n)?, settings(), vec![1.0]),
+    let (mut model, mesh, settings, targets, coarse) = match options.problem {
+        BenchProblem::Sphere => (build(n)?, QuadMesh::rectangle(0.0, 0.5 * SIDE, 0.0, 0.5 * SIDE, n, n)?, settings(), vec![1.0], None),
         BenchProblem::SphereDisplacement => {
-            let (setup, targets) = build_displacement(n)?;
-            (setup.model, setup.mesh.mesh, setup.settings, targets)
+            let (setup, targets) = build_displacement(n, options.predictor)?;
+            let coarse = setup.coarse.map(|c| crate::run::coarse::solve_coarse(*c, &setup.mesh, &targets));
+            (setup.model, setup.mesh.mesh, setup.settings, targets, coarse)
         }
     };
     // (no force-driven punch in either problem: `stamp run`'s BorderedSolver would be this solver)
     let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(options.reuse).with_preconditioner(!options.symmetric_part), settings);
+    let coarse = match coarse {
+        Some((path, report)) => {
+            if let Some(e) = &report.error {
+                return Err(StampError::Problem(format!("the coarse solve of predictor = \"coarse\" failed: {e}")));
+            }
+            crate::run::coarse::predict_from(&mut newton, path);
+            Some(CoarseRun { unknowns: report.equations, steps: report.steps, newton_iterations: report.newton_iterations, seconds: report.seconds })
+        }
+        None => None,
+    };
     let mut u = vec![0.0; model.num_dofs()];
     let summary = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |_, _, _| {})?;
 
@@ -246,6 +292,7 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
         linear_solver: newton.linear.stats(),
         centre_deflection: 0.5 * (u[2] + u[5]),
         reaction,
+        coarse,
     })
 }
 
@@ -259,6 +306,7 @@ pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut
             .args(if options.reuse { &["--reuse"][..] } else { &[][..] })
             .args(if options.symmetric_part { &["--symmetric-part"][..] } else { &[][..] })
             .args(["--problem", options.problem.name()])
+            .args(if options.predictor == BenchPredictor::Coarse { &["--predictor", "coarse"][..] } else { &[][..] })
             .output()
             .map_err(|e| StampError::io(&exe, e))?;
         if !out.status.success() {
@@ -272,15 +320,18 @@ pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut
 }
 
 /// The table header of the text report.
-pub fn header(problem: BenchProblem) -> String {
-    let title = match problem {
+pub fn header(options: SolverOptions) -> String {
+    let mut title = match options.problem {
         BenchProblem::Sphere => format!("simply supported square plate (side {SIDE}, h = {THICKNESS}, quarter model) under a sphere (R = {RADIUS}, travel {PUNCH_TRAVEL})"),
         BenchProblem::SphereDisplacement => "meshes/sphere-ss-displacement.toml: simply supported square plate (side 40, h = 1, quarter model) under a sphere (R = 200, travel 0.9, 5 targets)".into(),
     };
+    if options.predictor == BenchPredictor::Coarse {
+        title.push_str(";\npredictor = \"coarse\": every load step starts from the solution on the mesh with half the n");
+    }
     format!(
         "stamp bench: {title}\n\
-         {:>5} {:>9} {:>5} {:>4} {:>6} {:>5} {:>7} {:>4} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
-        "n", "unknowns", "steps", "cuts", "newton", "/step", "factors", "fthr", "gmres", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
+         {:>5} {:>9} {:>5} {:>4} {:>6} {:>5} {:>7} {:>7} {:>4} {:>6} | {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} | {:>9} | {:>10} {:>9}",
+        "n", "unknowns", "steps", "cuts", "newton", "/step", "coarse", "factors", "fthr", "gmres", "assembly", "contact", "symbolic", "factor", "solve", "output", "total", "peak RSS", "w_centre", "reaction"
     )
 }
 
@@ -288,13 +339,14 @@ pub fn header(problem: BenchProblem) -> String {
 pub fn row(r: &BenchRun) -> String {
     let s = &r.seconds;
     format!(
-        "{:>5} {:>9} {:>5} {:>4} {:>6} {:>5.1} {:>7} {:>4} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
+        "{:>5} {:>9} {:>5} {:>4} {:>6} {:>5.1} {:>7} {:>7} {:>4} {:>6} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} | {:>6.0} MiB | {:>10.6} {:>9.3}",
         r.n,
         r.unknowns,
         r.steps,
         r.cutbacks,
         r.newton_iterations,
         r.newton_iterations as f64 / r.steps.max(1) as f64,
+        r.coarse.as_ref().map(|c| c.newton_iterations.to_string()).unwrap_or_else(|| "-".into()),
         r.factorizations,
         r.factorization_threads,
         r.linear_solver.gmres_iterations,
@@ -311,16 +363,25 @@ pub fn row(r: &BenchRun) -> String {
     )
 }
 
+/// `--predictor coarse` needs the problem file's [solver] predictor.
+fn check_predictor(options: SolverOptions) -> Result<()> {
+    if options.predictor == BenchPredictor::Coarse && options.problem != BenchProblem::SphereDisplacement {
+        return Err(StampError::Problem("--predictor coarse is for --problem sphere-displacement (a problem file with a [solver] predictor)".into()));
+    }
+    Ok(())
+}
+
 /// `stamp bench`: all sizes, as a table or as JSON.
 pub fn bench_command(sizes: &[usize], json: bool, options: SolverOptions) -> Result<()> {
+    check_predictor(options)?;
     if json {
         let runs = run_sizes(sizes, options, |_| {})?;
         let text = serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).map_err(|e| StampError::Problem(e.to_string()))?;
         println!("{text}");
     } else {
-        println!("{}", header(options.problem));
+        println!("{}", header(options));
         run_sizes(sizes, options, |r| println!("{}", row(r)))?;
-        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; cuts: load increments cut back, newton: iterations of the converged steps (/step: per step), factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), fthr: their threads (the first two measure faer's parallel setting against one thread; the faster is kept), gmres: GMRES iterations", rayon::current_num_threads());
+        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; cuts: load increments cut back, newton: iterations of the converged steps (/step: per step), coarse: Newton iterations of the coarse solve that started every step (predictor = \"coarse\", a quarter of the unknowns; its time is in total), factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), fthr: their threads (the first two measure faer's parallel setting against one thread; the faster is kept), gmres: GMRES iterations", rayon::current_num_threads());
     }
     Ok(())
 }

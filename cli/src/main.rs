@@ -67,6 +67,10 @@ enum Command {
         /// `sphere-displacement` (meshes/sphere-ss-displacement.toml on n x n meshes).
         #[arg(long, value_enum, default_value = "sphere")]
         problem: stamp_cli::bench::BenchProblem,
+        /// With --problem sphere-displacement: start every load step from the solution on the
+        /// mesh with half the n (`[solver] predictor = "coarse"`) instead of the secant predictor.
+        #[arg(long, value_enum, default_value = "secant")]
+        predictor: stamp_cli::bench::BenchPredictor,
         /// Run one size in this process and print its JSON (used by `stamp bench` for each size).
         #[arg(long, hide = true)]
         one: Option<usize>,
@@ -81,10 +85,10 @@ fn main() -> ExitCode {
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
         Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
         Some(Command::Check { problem }) => stamp_cli::run::check_command(&problem),
-        Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem }),
-        Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, one: None }) => {
+        Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, predictor, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor }),
+        Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, predictor, one: None }) => {
             let sizes = sizes.unwrap_or_else(|| problem.default_sizes().to_vec());
-            stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem })
+            stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor })
         }
     };
     match result {
