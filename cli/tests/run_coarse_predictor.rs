@@ -95,11 +95,11 @@ fn refine_starts_every_finer_mesh_from_the_one_before() {
 }
 
 /// `stamp run` and `stamp check` refuse `text` (written as `case`.toml beside the shipped meshes)
-/// naming the file, "line L" of the line containing `at`, and every one of `wanted`.
+/// naming the file, "line L" of the first line that starts with `at`, and every one of `wanted`.
 fn refused(case: &str, shipped: &str, edits: &[(&str, &str)], at: &str, wanted: &[&str]) {
     let path = variant(case, shipped, edits);
     let text = std::fs::read_to_string(&path).unwrap();
-    let line = text.lines().position(|l| l.contains(at)).unwrap_or_else(|| panic!("{at} not in {case}")) + 1;
+    let line = text.lines().position(|l| l.trim_start().starts_with(at)).unwrap_or_else(|| panic!("no line starts with {at} in {case}")) + 1;
     let (code, err) = stamp_run(&path, &path.with_extension("out"), &[]);
     let check = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(&path).output().unwrap();
     let check_err = String::from_utf8_lossy(&check.stderr).into_owned();
