@@ -45,7 +45,11 @@ fn the_rectangle_with_half_its_n_starts_every_step_and_saves_iterations() {
     let secant = run(&variant("coarse-off", "sphere-ss-displacement.toml", &n40), "coarse-off-out");
     let mut edits = n40.to_vec();
     edits.push(("line_search_steps = 4", "line_search_steps = 4\npredictor = \"coarse\""));
-    let coarse = run(&variant("coarse-on", "sphere-ss-displacement.toml", &edits), "coarse-on-out");
+    let problem = variant("coarse-on", "sphere-ss-displacement.toml", &edits);
+    let check = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(&problem).output().unwrap();
+    let said = String::from_utf8_lossy(&check.stdout);
+    assert!(said.contains("predictor: every step starts from the solution on the coarse mesh (441 nodes, 400 elements"), "{said}");
+    let coarse = run(&problem, "coarse-on-out");
     let (a, b) = same_forces(&steps(&secant), &steps(&coarse), 1e-7);
     assert!(b < a, "{b} Newton iterations from the coarse mesh against {a} from the secant predictor");
     let s = summary(&coarse);

@@ -532,6 +532,15 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
     let _ = writeln!(o, "rigid-body motions: {rigid}");
     let targets = &setup.targets;
     let _ = write!(o, "load factors: {} target{} up to {}", targets.len(), if targets.len() == 1 { "" } else { "s" }, num(targets.iter().cloned().fold(0.0, f64::max)));
+    if let Some(coarse) = &setup.coarse {
+        let _ = write!(
+            o,
+            "\npredictor: every step starts from the solution on the coarse mesh ({} nodes, {} elements, {} equations), solved first",
+            coarse.mesh.mesh.num_nodes(),
+            coarse.mesh.mesh.num_cells(),
+            coarse.model.num_equations()
+        );
+    }
     o
 }
 
