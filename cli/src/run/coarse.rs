@@ -3,7 +3,8 @@
 //! load step on the problem's mesh starts from that solution interpolated onto it
 //! ([`stamp::coarse_path`]). The coarse solve writes no files; summary.json's `coarse_predictor`
 //! and a line on stderr report what it cost. A coarse solve that fails leaves the steps beyond
-//! its last converged state to the secant predictor (the run goes on and says so).
+//! its last converged state to the secant predictor (the run goes on and says so). `stamp run
+//! --refine` starts each finer mesh from the run before it the same way ([`PreviousLevel`]).
 
 use super::build::Setup;
 use super::mesh::MeshData;
@@ -11,8 +12,32 @@ use serde::Serialize;
 use stamp::coarse_path::CoarsePath;
 use stamp::linalg::bordered::BorderedSolver;
 use stamp::mesh_transfer::Prolongation;
+use stamp::mesh::QuadMesh;
 use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
+use std::sync::Arc;
 use std::time::Instant;
+
+/// A run on a coarser mesh whose converged states start every load step of another (`stamp run
+/// --refine`: the mesh before).
+#[derive(Debug, Clone)]
+pub struct PreviousLevel {
+    pub mesh: QuadMesh,
+    /// (load factor, unknowns) of every converged step.
+    pub states: Arc<Vec<(f64, Vec<f64>)>>,
+}
+
+impl PreviousLevel {
+    /// Its path (from the unloaded start) mapped onto `fine`, `components` unknowns per node.
+    pub fn path_onto(&self, fine: &QuadMesh, components: usize) -> CoarsePath {
+        let mut path = CoarsePath::new(Prolongation::between(&self.mesh, fine), components);
+        // prescribed values scale with the load factor: zero at the start
+        path.record(0.0, &vec![0.0; self.states.first().map(|s| s.1.len()).unwrap_or(0)]);
+        for (t, u) in self.states.iter() {
+            path.record(*t, u);
+        }
+        path
+    }
+}
 
 /// What the coarse solve cost and how far it went (summary.json `coarse_predictor`).
 #[derive(Debug, Clone, Serialize)]

@@ -34,13 +34,6 @@ pub struct RunOutcome {
     pub states: Vec<(f64, Vec<f64>)>,
 }
 
-/// A run on a coarser mesh whose converged states start every load step of this one (`stamp run
-/// --refine`: the mesh before).
-#[derive(Debug, Clone)]
-pub struct PreviousLevel {
-    pub mesh: stamp::mesh::QuadMesh,
-    pub states: Arc<Vec<(f64, Vec<f64>)>>,
-}
 
 /// How [`solve_and_write`] runs beyond the problem file.
 #[derive(Debug, Clone, Default)]
@@ -61,7 +54,7 @@ pub struct SolveOptions {
     pub record_states: bool,
     /// Start every load step from this run's solution (interpolated onto this mesh) instead of
     /// the secant predictor, or the `[solver] predictor = "coarse"` solve.
-    pub previous: Option<PreviousLevel>,
+    pub previous: Option<super::coarse::PreviousLevel>,
 }
 
 #[derive(Serialize)]
@@ -342,13 +335,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
     let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
     if let Some(previous) = &opts.previous {
-        let mut path = stamp::coarse_path::CoarsePath::new(stamp::mesh_transfer::Prolongation::between(&previous.mesh, &mesh.mesh), model.dofs.dofs_per_node());
-        // the path starts unloaded (prescribed values scale with the load factor)
-        path.record(0.0, &vec![0.0; previous.states.first().map(|s| s.1.len()).unwrap_or(0)]);
-        for (t, u) in previous.states.iter() {
-            path.record(*t, u);
-        }
-        super::coarse::predict_from(&mut newton, path);
+        super::coarse::predict_from(&mut newton, previous.path_onto(&mesh.mesh, model.dofs.dofs_per_node()));
     } else if let Some(coarse) = coarse {
         if !quiet {
             eprintln!("coarse predictor: solving on the coarse mesh ({} nodes) first", coarse.mesh.mesh.num_nodes());
