@@ -35,7 +35,7 @@ pub enum StampError {
     /// by the caller; this error says where it stopped.
     #[error(
         "Newton-Raphson did not converge in load step {step} (load factor {load_factor:.6e}) after \
-         {cutbacks} cut-backs: last residual {residual:.3e} (tolerance {tolerance:.3e}); {reason}"
+         {cutbacks} cut-backs of this step: last residual {residual:.3e} (tolerance {tolerance:.3e}); {reason}"
     )]
     NoConvergence {
         step: usize,

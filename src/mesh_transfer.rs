@@ -20,6 +20,9 @@ pub struct Prolongation {
     nodes: Vec<[usize; 4]>,
     weights: Vec<[f64; 4]>,
     coarse_nodes: usize,
+    /// The fine node farthest outside the coarse mesh and its distance from it (0 when every
+    /// node lies on a coarse cell).
+    farthest_outside: (usize, f64),
 }
 
 /// (s, t) in [-1, 1]^2 of the point `p` in the bilinear cell `x` (Newton on the bilinear map; a
@@ -68,7 +71,8 @@ impl Prolongation {
         let tree = RTree::bulk_load(boxes);
         let mut nodes = Vec::with_capacity(fine.num_nodes());
         let mut weights = Vec::with_capacity(fine.num_nodes());
-        for &p in &fine.coords {
+        let mut farthest_outside = (0, 0.0f64);
+        for (j, &p) in fine.coords.iter().enumerate() {
             // the cell whose square holds the point (the least outside it among the boxes that
             // hold it, or the nearest box when none does)
             let mut best: Option<(f64, usize, [f64; 2])> = None;
@@ -86,12 +90,29 @@ impl Prolongation {
                     consider(&mut best, b.data);
                 }
             }
-            let (_, c, [s, t]) = best.expect("a coarse mesh has cells");
+            let (outside, c, [s, t]) = best.expect("a coarse mesh has cells");
             let (n, _) = bilinear(s.clamp(-1.0, 1.0), t.clamp(-1.0, 1.0));
+            if outside > 0.0 {
+                // the distance from the point of the cell it was clamped to
+                let x = coarse.cell_coords(c);
+                let q = (0..2).map(|i| (0..4).map(|a| n[a] * x[a][i]).sum::<f64>()).collect::<Vec<f64>>();
+                let d = (q[0] - p[0]).hypot(q[1] - p[1]);
+                if d > farthest_outside.1 {
+                    farthest_outside = (j, d);
+                }
+            }
             nodes.push(coarse.cells[c]);
             weights.push(n);
         }
-        Prolongation { nodes, weights, coarse_nodes: coarse.num_nodes() }
+        Prolongation { nodes, weights, coarse_nodes: coarse.num_nodes(), farthest_outside }
+    }
+
+    /// The fine node farthest outside the coarse mesh (0-based) and its distance from the nearest
+    /// coarse cell's point it takes its values from; distance 0 when every node lies on the
+    /// coarse mesh. A curved boundary meshed twice leaves nodes a sagitta outside; a coarse mesh
+    /// of another region leaves them far outside.
+    pub fn farthest_outside(&self) -> (usize, f64) {
+        self.farthest_outside
     }
 
     /// The fine vector of `components` values per node from the coarse one (node-major: node k's
@@ -163,5 +184,10 @@ mod tests {
             let want = if j == out { xy([2.0, p[1]]) } else { xy(p) };
             assert!((fine_values[j] - want).abs() < 1e-12, "node {j} at {p:?}: {} against {want}", fine_values[j]);
         }
+        let (node, distance) = Prolongation::between(&coarse, &fine).farthest_outside();
+        assert_eq!(node, out);
+        assert!((distance - 0.1).abs() < 1e-12, "{distance}");
+        // every node inside (those on the boundary within round-off)
+        assert!(Prolongation::between(&coarse, &QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 7, 5).unwrap()).farthest_outside().1 < 1e-12);
     }
 }

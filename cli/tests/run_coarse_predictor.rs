@@ -109,7 +109,7 @@ fn refused(case: &str, shipped: &str, edits: &[(&str, &str)], at: &str, wanted: 
     let check_err = String::from_utf8_lossy(&check.stderr).into_owned();
     for (what, code, err) in [("run", code, &err), ("check", check.status.code(), &check_err)] {
         assert_eq!(code, Some(1), "{case} ({what}): {err}");
-        assert!(err.contains(&format!("{case}.toml: line {line},")), "{case} ({what}): not at line {line}: {err}");
+        assert!(err.contains(&format!("{case}.toml: ")) && err.contains(&format!("line {line}, column")), "{case} ({what}): not at line {line}: {err}");
         for w in wanted {
             assert!(err.contains(w), "{case} ({what}): no '{w}' in: {err}");
         }
@@ -130,6 +130,8 @@ fn bad_combinations_are_refused_with_the_key_and_the_line() {
     refused("no-coarse-file", "disk-clamped.toml", &[gmsh], "predictor", &["solver.predictor", "coarse_file"]);
     refused("coarse-file-alone", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"disk-clamped.msh\"")], "coarse_file", &["mesh.coarse_file", "predictor = \"coarse\""]);
     refused("coarse-file-missing", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"nothere.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "nothere.msh", "does not exist"]);
-    refused("coarse-file-groups", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"paper-r100.msh\""), gmsh], "group = \"left\"", &["boundary[0].group", "'left'", "coarse mesh paper-r100.msh"]);
+    refused("coarse-file-groups", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"sphere-ss-full.msh\""), gmsh], "group = \"left\"", &["coarse mesh sphere-ss-full.msh", "boundary[0].group", "'left'"]);
+    // a mesh of another plate (the paper's strip, 1 x 100): the disk's node at (20, 0) is 19 away
+    refused("coarse-file-elsewhere", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"paper-r100.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "does not cover the plate", "gmsh node", "(20, 0)", "19 outside"]);
     refused("coarse-file-finer", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"disk-clamped-lc1.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "2359 nodes", "fewer"]);
 }

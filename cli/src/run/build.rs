@@ -31,6 +31,7 @@
 //!   while nothing touches, the closest point pulls it down (see `ContactPair::evaluate`).
 
 use super::mesh::{group_error, MeshData};
+use super::rigid_modes::num;
 use super::plate_model::{Layout, Plate};
 use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape};
 use nalgebra::Vector3;
@@ -177,8 +178,27 @@ fn build_coarse(p: &Problem, fine: &MeshData) -> Result<Setup> {
             format!("{what} has {} nodes, the mesh {}: the coarse mesh must have fewer", coarse.mesh.num_nodes(), fine.mesh.num_nodes()),
         ));
     }
+    // the same plate: no node of the mesh farther outside the coarse one than a fifth of a coarse
+    // cell (a curved edge meshed twice leaves its nodes a sagitta outside, l^2 / 8R)
+    let (node, distance) = stamp::mesh_transfer::Prolongation::between(&coarse.mesh, &fine.mesh).farthest_outside();
+    let allowed = 0.2 * coarse.element_size();
+    if distance > allowed {
+        let x = fine.mesh.coords[node];
+        let tag = fine.node_tags.as_ref().map(|t| format!("gmsh node {}", t[node])).unwrap_or_else(|| format!("node {}", node + 1));
+        return Err(p.error_at(
+            span,
+            "mesh.coarse_file",
+            format!(
+                "{what} does not cover the plate: {tag} at ({}, {}) lies {} outside it (at most {} allowed, a fifth of its cells); the coarse mesh must mesh the same plate",
+                num(x[0]),
+                num(x[1]),
+                num(distance),
+                num(allowed)
+            ),
+        ));
+    }
     build_on(p, coarse).map_err(|e| match e {
-        StampError::Input { file, message } => StampError::Input { file, message: format!("{message} (on {what} of [solver] predictor = \"coarse\")") },
+        StampError::Input { file, message } => StampError::Input { file, message: format!("{what} of [solver] predictor = \"coarse\" does not fit the problem: {message}") },
         e => StampError::Problem(format!("{what} of [solver] predictor = \"coarse\": {e}")),
     })
 }
