@@ -278,6 +278,11 @@ pub trait NonlinearSolver {
     ) -> Result<SolveSummary>;
 }
 
+/// Attempts of a load step started from [`NewtonRaphson::predictor`]; its later retries (cut
+/// back) start from the secant extrapolation, in case the prediction is what fails (a coarse
+/// mesh far from the answer).
+pub const PREDICTED_ATTEMPTS: usize = 2;
+
 /// Newton-Raphson with a direct linear solver, load stepping and cut-back.
 pub struct NewtonRaphson<L: LinearSolver> {
     pub settings: NewtonSettings,
@@ -292,7 +297,8 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// of the last converged state, load factor of the step, the start to set); true when it set
     /// the start (then used instead of the secant extrapolation, see
     /// [`NonlinearProblem::start_predicted`]), false to keep the extrapolation. A
-    /// [`crate::coarse_path::CoarsePath`], say.
+    /// [`crate::coarse_path::CoarsePath`], say. Not asked for the retries of a step after
+    /// [`PREDICTED_ATTEMPTS`] failed attempts in a row.
     pub predictor: Option<Box<dyn FnMut(usize, f64, f64, &mut [f64]) -> bool>>,
 }
 
@@ -548,7 +554,9 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         }
                     }
                 }
-                let predicted = self.predictor.as_mut().is_some_and(|predict| predict(summary.steps, t, step_t, &mut trial));
+                // a step the prediction failed twice in a row retries from the extrapolation
+                let trusted = cutbacks_in_row < PREDICTED_ATTEMPTS;
+                let predicted = trusted && self.predictor.as_mut().is_some_and(|predict| predict(summary.steps, t, step_t, &mut trial));
                 p.apply_prescribed(&mut trial, step_t);
                 p.start_step();
                 p.start_predicted(predicted);
@@ -750,6 +758,34 @@ mod tests {
         let mut iterations = Vec::new();
         newton.solve_path(&mut Line::new(), &mut u, 0.0, &[1.0], &mut |r, _, _| iterations.push(r.iterations)).unwrap();
         assert_eq!(iterations[0], 1);
+    }
+
+    /// A prediction that makes the residual NaN fails the step; after PREDICTED_ATTEMPTS such
+    /// attempts the retries start from the secant extrapolation and the path goes on.
+    #[test]
+    fn a_failing_prediction_is_dropped_after_two_attempts() {
+        let mut newton = NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_increment: 1.0, ..settings() });
+        let calls = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let seen = calls.clone();
+        // the first step's predictions are NaN, the later steps are not predicted
+        newton.predictor = Some(Box::new(move |steps, from, to, u| {
+            seen.borrow_mut().push((steps, from, to));
+            if steps == 0 {
+                u[0] = f64::NAN;
+            }
+            steps == 0
+        }));
+        let mut u = vec![0.0];
+        let summary = newton.solve_path(&mut Line::new(), &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
+        assert_eq!(PREDICTED_ATTEMPTS, 2);
+        // the first step was asked for in full and in half, then no more: the quarter step
+        // converged from the secant start
+        let first: Vec<_> = calls.borrow().iter().filter(|c| c.0 == 0).cloned().collect();
+        assert_eq!(first, vec![(0, 0.0, 1.0), (0, 0.0, 0.5)]);
+        // the next call is the next step's, from the quarter step's converged 0.25
+        assert_eq!((calls.borrow()[2].0, calls.borrow()[2].1), (1, 0.25));
+        assert_eq!(summary.cutbacks, 2);
+        assert!((u[0] - 1.0).abs() < 1e-12);
     }
 
     #[test]
