@@ -29,7 +29,8 @@ enum Command {
         /// Output folder (default: next to the problem file, named after it).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// No progress bar.
+        /// Print nothing but warnings and errors: no progress, no table (the outputs are written
+        /// all the same).
         #[arg(long, short)]
         quiet: bool,
         /// Also solve on the mesh refined LEVELS times (default 1; each cell into 4 every time) at
