@@ -249,6 +249,9 @@ pub struct StepReport {
     /// Residual norm at every iteration of the final (converged) attempt, the last one converged.
     pub residual_history: Vec<f64>,
     pub cutbacks: usize,
+    /// Newton iterations of this step's attempts that failed and were cut back (not in
+    /// `iterations`).
+    pub failed_iterations: usize,
     /// True when this step ends at one of the requested targets.
     pub is_target: bool,
     pub target_index: Option<usize>,
@@ -258,8 +261,11 @@ pub struct StepReport {
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct SolveSummary {
     pub steps: usize,
+    /// Of the converged steps (see [`StepReport::iterations`]).
     pub newton_iterations: usize,
     pub cutbacks: usize,
+    /// Of the attempts that failed and were cut back.
+    pub failed_iterations: usize,
     pub seconds: f64,
 }
 
@@ -300,11 +306,13 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// [`crate::coarse_path::CoarsePath`], say. Not asked for the retries of a step after
     /// [`PREDICTED_ATTEMPTS`] failed attempts in a row.
     pub predictor: Option<Box<dyn FnMut(usize, f64, f64, &mut [f64]) -> bool>>,
+    /// Newton iterations done so far, failed attempts included.
+    iterations_done: usize,
 }
 
 impl<L: LinearSolver> NewtonRaphson<L> {
     pub fn new(linear: L, settings: NewtonSettings) -> Self {
-        NewtonRaphson { settings, linear, on_iteration: None, stop: None, predictor: None }
+        NewtonRaphson { settings, linear, on_iteration: None, stop: None, predictor: None, iterations_done: 0 }
     }
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
@@ -339,6 +347,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         // update inside Newton (a re-solve of the step after end_step had a budget of its own)
         let mut budget_start = 0;
         for it in 0.. {
+            if it > 0 {
+                self.iterations_done += 1;
+            }
             let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
                 None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true),
@@ -536,6 +547,8 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
             }
             // Targets may go up or down (loading, then unloading): step towards each in turn.
             let mut cutbacks_in_row = 0;
+            // iterations of the attempts of this step that failed
+            let mut failed_iterations = 0;
             while t != target {
                 let remaining = target - t;
                 let step_t = if dt >= remaining.abs() * (1.0 - 1e-12) { target } else { t + dt.copysign(remaining) };
@@ -564,6 +577,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 let mut updates = 0;
                 // iterations of the re-solves of this step before the last one
                 let mut restart_iterations = 0;
+                let attempt_start = self.iterations_done;
                 let result = loop {
                     match self.iterate(p, &mut trial, step_t, &mut updates, &mut peak_energy, &mut last_tol) {
                         Ok((h, before_update)) => {
@@ -615,6 +629,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             iterations: restart_iterations + iterations,
                             residual_history: history,
                             cutbacks: cutbacks_in_row,
+                            failed_iterations,
                             is_target,
                             target_index: is_target.then_some(ti),
                         };
@@ -624,11 +639,14 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             return Err(StampError::Problem(format!("stopped on request after load step {} (load factor {t:.6e})", summary.steps)));
                         }
                         cutbacks_in_row = 0;
+                        failed_iterations = 0;
                         if last_round <= self.settings.easy_iterations {
                             dt = (dt * self.settings.growth).min(self.settings.max_increment);
                         }
                     }
                     Err((reason, residual, tolerance)) => {
+                        failed_iterations += self.iterations_done - attempt_start;
+                        summary.failed_iterations += self.iterations_done - attempt_start;
                         p.restore();
                         cutbacks_in_row += 1;
                         summary.cutbacks += 1;

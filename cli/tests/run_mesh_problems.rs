@@ -257,6 +257,14 @@ fn cylinder_at_30_degrees() {
     let name = "cylinder-30deg";
     let (s, out) = run_mesh(name);
     check_common(name, &s);
+    // its steps are cut back (5 times, measured): the failed attempts' iterations are reported per
+    // step and in all, apart from the converged attempts' newton_iterations
+    let failed: Vec<(u64, u64)> = steps(&s).iter().map(|x| (x["cutbacks"].as_u64().unwrap(), x["failed_iterations"].as_u64().unwrap())).collect();
+    assert!(failed.iter().any(|c| c.0 > 0), "no step was cut back: {failed:?}");
+    for (k, (cutbacks, iterations)) in failed.iter().enumerate() {
+        assert_eq!(*cutbacks == 0, *iterations == 0, "step {}: {cutbacks} cut-backs, {iterations} iterations in failed attempts", k + 1);
+    }
+    assert_eq!(s["failed_iterations"].as_u64().unwrap(), failed.iter().map(|c| c.1).sum::<u64>());
     let last = steps(&s).last().unwrap();
     // the contact forces lie along the cylinder's axis, 30 degrees to x1: a band along the whole
     // plate, every loaded node within two elements of the axis, its principal direction (q_n-weighted

@@ -92,8 +92,11 @@ pub struct StepEntry {
     pub path: f64,
     pub is_target: bool,
     pub converged: bool,
+    /// Of the attempt that converged (augmented-Lagrangian rounds included).
     pub newton_iterations: usize,
     pub cutbacks: usize,
+    /// Newton iterations of the attempts cut back before it.
+    pub failed_iterations: usize,
     pub residual_history: Vec<f64>,
     /// Nodes in the active set of any punch.
     pub active_nodes: usize,
@@ -323,6 +326,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         converged: true,
         newton_iterations: report.iterations,
         cutbacks: report.cutbacks,
+        failed_iterations: report.failed_iterations,
         residual_history: report.residual_history.clone(),
         active_nodes: active.iter().filter(|&&a| a > 0.0).count(),
         loaded_nodes: loaded.iter().filter(|&&a| a > 0.0).count(),

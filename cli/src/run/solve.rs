@@ -100,6 +100,9 @@ struct Summary {
     punches: Vec<PunchMeta>,
     loaded_threshold: f64,
     newton_iterations: usize,
+    /// Newton iterations of the attempts cut back before the converged steps (not in
+    /// `newton_iterations`).
+    failed_iterations: usize,
     seconds: f64,
     point_arrays: Vec<String>,
     cell_arrays: Vec<String>,
@@ -189,13 +192,19 @@ impl Progress {
 
     /// `forces`: the punches' forces and travels, appended to the terse line.
     #[allow(clippy::too_many_arguments)]
-    fn step(&self, step: usize, t: f64, path: f64, iterations: usize, active: usize, penetration: f64, forces: &str) {
+    fn step(&self, rep: &stamp::nonlinear::StepReport, path: f64, active: usize, penetration: f64, forces: &str) {
+        let (step, t, iterations) = (rep.step, rep.load_factor, rep.iterations);
         *self.state.lock().unwrap() = (step, t);
+        // a step cut back says so, with the iterations of its failed attempts
+        let cut = match rep.cutbacks {
+            0 => String::new(),
+            c => format!(" (after {c} cut-back{}, {} iterations in the failed attempts)", if c == 1 { "" } else { "s" }, rep.failed_iterations),
+        };
         if let Some(b) = &self.bar {
             b.set_position(((path / self.path_end) * 1000.0).round().clamp(0.0, 1000.0) as u64);
-            b.set_message(format!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact, max penetration {penetration:.2e}"));
+            b.set_message(format!("step {step} converged at t = {t:.4} in {iterations} iterations{cut}, {active} nodes in contact, max penetration {penetration:.2e}"));
         } else if self.terse {
-            eprintln!("step {step} converged at t = {t:.4} in {iterations} iterations, {active} nodes in contact{forces}, max penetration {penetration:.2e}");
+            eprintln!("step {step} converged at t = {t:.4} in {iterations} iterations{cut}, {active} nodes in contact{forces}, max penetration {penetration:.2e}");
         }
     }
 
@@ -314,6 +323,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             .collect(),
         loaded_threshold: out.loaded_threshold.0,
         newton_iterations: 0,
+        failed_iterations: 0,
         seconds: 0.0,
         point_arrays: super::output::POINT_ARRAYS.iter().filter(|n| **n != "gap" || !punches.is_empty()).map(|s| s.to_string()).collect(),
         cell_arrays: super::output::CELL_ARRAYS.iter().map(|s| s.to_string()).collect(),
@@ -327,6 +337,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut files: Vec<PathBuf> = Vec::new();
     let mut write_error: Option<StampError> = None;
     let mut total_iterations = 0;
+    let mut total_failed = 0;
     // a reader sees "running" (with our pid) from the start
     write_summary(&summary_path, &summary, None)?;
 
@@ -358,6 +369,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
     let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
         total_iterations += rep.iterations;
+        total_failed += rep.failed_iterations;
         if opts.record_states {
             states.push((rep.load_factor, u.to_vec()));
         }
@@ -376,7 +388,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         let penetration = m.contacts.iter().map(|c| c.max_penetration()).fold(0.0, f64::max);
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
         let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u).clone();
-        progress.step(rep.step, t, path_len, rep.iterations, active, penetration, &history.terse_forces());
+        progress.step(rep, path_len, active, penetration, &history.terse_forces());
         if write_error.is_some() {
             return;
         }
@@ -433,6 +445,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             summary.steps.push(serde_json::to_value(&data.entry).map_err(json_err)?);
             listed = true;
             summary.newton_iterations = total_iterations;
+            summary.failed_iterations = total_failed;
             summary.seconds = start.elapsed().as_secs_f64();
             // a failed write here is retried at the end (with the failure)
             write_summary(&summary_path, &summary, None)
@@ -458,6 +471,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     progress.finish();
     drop(cx);
     summary.newton_iterations = total_iterations;
+    summary.failed_iterations = total_failed;
     // after a write failure the solve stopped on request: that is no failure of its own
     let surface_error = surface_error.or_else(|| surface_failure(p, &model.contacts));
     let solve_failure = if write_error.is_some() { None } else { surface_error.or(result.err()) };
