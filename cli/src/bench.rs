@@ -109,6 +109,10 @@ pub struct BenchRun {
     #[serde(default)]
     pub cutbacks: usize,
     pub newton_iterations: usize,
+    /// Newton iterations of the attempts that were cut back (not in `newton_iterations`; their
+    /// factorisations are in `factorizations`).
+    #[serde(default)]
+    pub failed_iterations: usize,
     pub seconds: Seconds,
     pub peak_rss_bytes: u64,
     pub assemblies: usize,
@@ -275,6 +279,7 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
         steps: summary.steps,
         cutbacks: summary.cutbacks,
         newton_iterations: summary.newton_iterations,
+        failed_iterations: summary.failed_iterations,
         seconds: Seconds {
             assembly: mt.assembly,
             contact: mt.contact,
