@@ -133,5 +133,12 @@ fn bad_combinations_are_refused_with_the_key_and_the_line() {
     refused("coarse-file-groups", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"sphere-ss-full.msh\""), gmsh], "group = \"left\"", &["coarse mesh sphere-ss-full.msh", "boundary[0].group", "'left'"]);
     // a mesh of another plate (the paper's strip, 1 x 100): the disk's node at (20, 0) is 19 away
     refused("coarse-file-elsewhere", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"paper-r100.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "does not cover the plate", "gmsh node", "(20, 0)", "19 outside"]);
+    // an unreadable coarse file: the reader's message names it, and says which key of which
+    // problem file asked for it
+    let path = variant("coarse-file-msh22", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"old.msh\""), gmsh]);
+    write(path.parent().unwrap(), "old.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n");
+    let (code, err) = stamp_run(&path, &path.with_extension("out"), &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("old.msh: MSH format version 2.2") && err.contains("read as mesh.coarse_file of") && err.contains("coarse-file-msh22.toml"), "{err}");
     refused("coarse-file-finer", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"disk-clamped-lc1.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "2359 nodes", "fewer"]);
 }

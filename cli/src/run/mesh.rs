@@ -59,7 +59,11 @@ impl MeshData {
         if !path.exists() {
             return Err(p.error_at(file.span(), key, format!("{} does not exist", path.display())));
         }
-        let g = read_msh(&path)?;
+        // the reader names the .msh file; the problem file and its key say where it was asked for
+        let g = read_msh(&path).map_err(|e| match e {
+            StampError::Input { file, message } => StampError::Input { file, message: format!("{message} (read as {key} of {})", p.path.display()) },
+            e => e,
+        })?;
         let surfaces = g.mesh.cell_groups.clone();
         let split = g.split_summary();
         Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh, split })
