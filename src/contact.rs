@@ -350,6 +350,8 @@ impl ContactPair {
 
     /// Forget the cycling history (at the start of a load step).
     pub fn start_step(&mut self) {
+        // from the secant predictor unless start_predicted says otherwise
+        self.predicted_step = false;
         self.flips.fill(0);
         self.frozen.fill(false);
         self.step_start = true;
@@ -453,7 +455,8 @@ impl ContactPair {
         // at a point, and taking the whole overlap in puts every point on the punch's tangent
         // plane, from where the convex Psi releases them all (the set then ping-pongs and
         // shrinks ring by ring). The first iteration of a step damps harder
-        // (STEP_START_ENTRY_FRACTION): the predictor's penetrations overshoot.
+        // (STEP_START_ENTRY_FRACTION): the predictor's penetrations overshoot. A step started from
+        // an outside prediction (`predicted_step`) is not damped at all.
         let damped = with_tangent && !self.hold_active_set && self.entry_fraction > 0.0 && !self.predicted_step;
         let first_touch = self.first_touch_fraction.filter(|_| damped);
         let empty = first || !self.last_active.iter().zip(&self.frozen).any(|(a, f)| *a || *f);

@@ -3,8 +3,10 @@
 //! for a fine mesh that is a uniform refinement of the coarse one (every fine node lies on a
 //! coarse cell, where the interpolant is the coarse finite-element field itself); for two
 //! independent meshes of the same region it is the coarse field at the fine node, and a fine node
-//! just outside the coarse mesh (a curved boundary meshed twice) takes the value of the nearest
-//! coarse cell's closest point.
+//! just outside the coarse mesh (a curved boundary meshed twice) takes the value at the point of
+//! the cell whose reference coordinates it exceeds least, clamped to the cell's square (the
+//! nearest point of the cell for a parallelogram; close to it for the cells a mesh generator
+//! makes). [`Prolongation::farthest_outside`] says how far outside the farthest node lies.
 //!
 //! Used by [`crate::coarse_path`] to start the load steps of a fine mesh from the solution on a
 //! coarse one.
@@ -52,8 +54,11 @@ fn local_coordinates(x: &[[f64; 2]; 4], p: [f64; 2]) -> ([f64; 2], f64) {
             break;
         }
     }
-    let outside = (s.abs() - 1.0).max(0.0) + (t.abs() - 1.0).max(0.0);
-    ([s, t], if outside.is_finite() { outside } else { f64::INFINITY })
+    if !(s.is_finite() && t.is_finite()) {
+        // a degenerate cell: never the one that holds the point
+        return ([0.0; 2], f64::INFINITY);
+    }
+    ([s, t], (s.abs() - 1.0).max(0.0) + (t.abs() - 1.0).max(0.0))
 }
 
 impl Prolongation {

@@ -315,6 +315,13 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         NewtonRaphson { settings, linear, on_iteration: None, stop: None, predictor: None, iterations_done: 0 }
     }
 
+    /// Newton iterations done so far by this solver, those of attempts that failed included (a
+    /// path that failed returns no [`SolveSummary`]: the caller subtracts what its steps
+    /// reported).
+    pub fn iterations_done(&self) -> usize {
+        self.iterations_done
+    }
+
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
     /// and the iterations before the last multiplier update inside Newton (0 without one), or the
     /// reason for failure.

@@ -243,6 +243,13 @@ fn after_a_failure_the_table_history_and_plots_hold_what_converged() {
     let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     let done: Vec<&Value> = s["steps"].as_array().unwrap().iter().filter(|e| e["converged"] == true).collect();
     assert_eq!(done.len(), 1, "{s}");
+    // the failed step's 6 iterations (max_iterations, no cut-back) are reported, in its entry and
+    // in all, beside the converged step's
+    let failed = s["steps"].as_array().unwrap().last().unwrap();
+    assert_eq!(failed["converged"], false);
+    assert_eq!(failed["failed_iterations"], 6, "{failed}");
+    assert_eq!(s["failed_iterations"], 6);
+    assert_eq!(s["newton_iterations"], done[0]["newton_iterations"]);
     let (_, hist) = read_csv(&out.join("history.csv"));
     assert_eq!(hist.len(), 1);
     assert!(close(hist[0][4], -f(&done[0]["punches"]["sphere"]["reaction"][2]), 1e-14, 0.0));

@@ -69,7 +69,14 @@ pub struct Setup {
     pub settings: NewtonSettings,
     /// `[solver] predictor = "coarse"`: the same problem on the coarse mesh (solved first, see
     /// super::coarse); None otherwise, and on the meshes of `--refine`.
-    pub coarse: Option<Box<Setup>>,
+    pub coarse: Option<Box<CoarseSetup>>,
+}
+
+/// The problem on the coarse mesh of `predictor = "coarse"` and the map of its nodal fields
+/// onto the problem's mesh.
+pub struct CoarseSetup {
+    pub setup: Setup,
+    pub prolongation: stamp::mesh_transfer::Prolongation,
 }
 
 fn face_of(f: PunchFace) -> Face {
@@ -157,50 +164,56 @@ pub fn build(p: &Problem) -> Result<Setup> {
 }
 
 /// The problem on the coarse mesh of `predictor = "coarse"`; its errors say that they are the
-/// coarse mesh's (a group the coarse file lacks, a rectangle too coarse for a `center`).
-fn build_coarse(p: &Problem, fine: &MeshData) -> Result<Setup> {
+/// coarse mesh's (a group the coarse file lacks, a rectangle too coarse for a `center`, a mesh
+/// that does not cover the plate).
+fn build_coarse(p: &Problem, fine: &MeshData) -> Result<CoarseSetup> {
     let key = p.spec.solver.predictor.as_ref().map(|k| k.span()).unwrap_or_else(|| p.spec.mesh.span());
-    let (what, span) = match &p.spec.mesh.get_ref().coarse_file {
-        Some(f) => (format!("the coarse mesh {}", f.get_ref()), f.span()),
+    let (what, span, span_key) = match &p.spec.mesh.get_ref().coarse_file {
+        Some(f) => (format!("the coarse mesh {}", f.get_ref()), f.span(), "mesh.coarse_file"),
         None => {
             let r = p.spec.mesh.get_ref().rectangle.as_ref().expect("checked: file or rectangle");
-            (format!("the coarse mesh (the rectangle with n = [{}, {}])", r.n[0] / 2, r.n[1] / 2), key)
+            (format!("the coarse mesh (the rectangle with n = [{}, {}])", r.n[0] / 2, r.n[1] / 2), key, "solver.predictor")
         }
     };
     let coarse = MeshData::load_coarse(p).map_err(|e| match e {
-        StampError::Mesh(m) => p.error_at(span.clone(), "mesh.coarse_file", m),
+        StampError::Mesh(m) => p.error_at(span.clone(), span_key, m),
         e => e,
     })?;
     if coarse.mesh.num_nodes() >= fine.mesh.num_nodes() {
         return Err(p.error_at(
             span,
-            "mesh.coarse_file",
+            span_key,
             format!("{what} has {} nodes, the mesh {}: the coarse mesh must have fewer", coarse.mesh.num_nodes(), fine.mesh.num_nodes()),
         ));
     }
     // the same plate: no node of the mesh farther outside the coarse one than a fifth of a coarse
     // cell (a curved edge meshed twice leaves its nodes a sagitta outside, l^2 / 8R)
-    let (node, distance) = stamp::mesh_transfer::Prolongation::between(&coarse.mesh, &fine.mesh).farthest_outside();
+    let prolongation = stamp::mesh_transfer::Prolongation::between(&coarse.mesh, &fine.mesh);
+    let (node, distance) = prolongation.farthest_outside();
     let allowed = 0.2 * coarse.element_size();
     if distance > allowed {
-        let x = fine.mesh.coords[node];
-        let tag = fine.node_tags.as_ref().map(|t| format!("gmsh node {}", t[node])).unwrap_or_else(|| format!("node {}", node + 1));
         return Err(p.error_at(
             span,
-            "mesh.coarse_file",
+            span_key,
             format!(
-                "{what} does not cover the plate: {tag} at ({}, {}) lies {} outside it (at most {} allowed, a fifth of its cells); the coarse mesh must mesh the same plate",
-                num(x[0]),
-                num(x[1]),
+                "{what} does not cover the plate: {} of the mesh lies {} outside it (at most {} allowed, a fifth of its mean cell size); the coarse mesh must mesh the same plate",
+                super::check::where_node(fine, node),
                 num(distance),
                 num(allowed)
             ),
         ));
     }
-    build_on(p, coarse).map_err(|e| match e {
-        StampError::Input { file, message } => StampError::Input { file, message: format!("{what} of [solver] predictor = \"coarse\" does not fit the problem: {message}") },
+    // a mesh error of the coarse file names the coarse file (mesh_error names `mesh.file`)
+    let fine_file = p.spec.mesh.get_ref().file.as_ref().map(|f| p.dir().join(f.get_ref()).display().to_string());
+    let coarse_file = p.spec.mesh.get_ref().coarse_file.as_ref().map(|f| p.dir().join(f.get_ref()).display().to_string());
+    let setup = build_on(p, coarse).map_err(|e| match e {
+        StampError::Input { file, message } => {
+            let file = if Some(&file) == fine_file.as_ref() { coarse_file.clone().unwrap_or(file) } else { file };
+            StampError::Input { file, message: format!("{what} of [solver] predictor = \"coarse\" does not fit the problem: {message}") }
+        }
         e => StampError::Problem(format!("{what} of [solver] predictor = \"coarse\": {e}")),
-    })
+    })?;
+    Ok(CoarseSetup { setup, prolongation })
 }
 
 /// Build everything the solve needs on the given mesh (the problem's own, or its refinement: the

@@ -93,7 +93,7 @@ fn bbox(mesh: &MeshData) -> ([f64; 2], [f64; 2]) {
 
 /// "node at (x1, x2) = (1, 2) (gmsh node 17)"; a node the reader or a refinement added (tag 0)
 /// has no gmsh tag to name.
-fn where_node(mesh: &MeshData, node: usize) -> String {
+pub fn where_node(mesh: &MeshData, node: usize) -> String {
     let x = mesh.mesh.coords[node];
     let tag = match mesh.node_tags.as_ref().and_then(|t| t.get(node)) {
         Some(0) => " (not a gmsh node: added where a cell was cut)".to_string(),
@@ -536,9 +536,9 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
         let _ = write!(
             o,
             "\npredictor: every step starts from the solution on the coarse mesh ({} nodes, {} elements, {} equations), solved first",
-            coarse.mesh.mesh.num_nodes(),
-            coarse.mesh.mesh.num_cells(),
-            coarse.model.num_equations()
+            coarse.setup.mesh.mesh.num_nodes(),
+            coarse.setup.mesh.mesh.num_cells(),
+            coarse.setup.model.num_equations()
         );
     }
     o

@@ -6,8 +6,7 @@
 //! its last converged state to the secant predictor (the run goes on and says so). `stamp run
 //! --refine` starts each finer mesh from the run before it the same way ([`PreviousLevel`]).
 
-use super::build::Setup;
-use super::mesh::MeshData;
+use super::build::{CoarseSetup, Setup};
 use serde::Serialize;
 use stamp::coarse_path::CoarsePath;
 use stamp::linalg::bordered::BorderedSolver;
@@ -45,8 +44,12 @@ pub struct CoarseReport {
     pub nodes: usize,
     pub equations: usize,
     pub steps: usize,
+    /// Of the converged steps (a failed solve's last step: in `error`).
     pub cutbacks: usize,
+    /// Of the converged steps' attempts that converged.
     pub newton_iterations: usize,
+    /// Of the attempts that failed and were cut back (a failed solve's last step included).
+    pub failed_iterations: usize,
     pub seconds: f64,
     /// The load factor of its last converged state (the run's last target when it converged).
     pub reached_load_factor: f64,
@@ -68,11 +71,12 @@ impl CoarseReport {
     }
 }
 
-/// Solve `coarse` along `targets` and return its path mapped onto `fine`, with its report.
-pub fn solve_coarse(coarse: Setup, fine: &MeshData, targets: &[f64]) -> (CoarsePath, CoarseReport) {
+/// Solve `coarse` along `targets` and return its path mapped onto the problem's mesh, with its
+/// report.
+pub fn solve_coarse(coarse: CoarseSetup, targets: &[f64]) -> (CoarsePath, CoarseReport) {
     let start = Instant::now();
-    let Setup { mesh, mut model, settings, .. } = coarse;
-    let mut path = CoarsePath::new(Prolongation::between(&mesh.mesh, &fine.mesh), model.dofs.dofs_per_node());
+    let CoarseSetup { setup: Setup { mesh, mut model, settings, .. }, prolongation } = coarse;
+    let mut path = CoarsePath::new(prolongation, model.dofs.dofs_per_node());
     let mut u = vec![0.0; model.num_dofs()];
     model.apply_prescribed(&mut u, 0.0);
     path.record(0.0, &u);
@@ -92,6 +96,7 @@ pub fn solve_coarse(coarse: Setup, fine: &MeshData, targets: &[f64]) -> (CoarseP
         newton_iterations: iterations,
         seconds: start.elapsed().as_secs_f64(),
         reached_load_factor: path.last_load_factor().unwrap_or(0.0),
+        failed_iterations: newton.iterations_done().saturating_sub(iterations),
         error: result.err().map(|e| e.to_string()),
     };
     (path, report)

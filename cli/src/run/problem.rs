@@ -906,7 +906,7 @@ impl Problem {
             (None, None, Some(k)) => {
                 return Err(self.error_at(k.span(), "solver.predictor", "\"coarse\" with a gmsh mesh needs [mesh] coarse_file: the same plate meshed coarser, with the same physical groups"));
             }
-            (Some(r), None, Some(k)) if r.n[0] % 2 == 1 || r.n[1] % 2 == 1 || r.n[0] < 2 || r.n[1] < 2 => {
+            (Some(r), None, Some(k)) if r.n[0] % 2 == 1 || r.n[1] % 2 == 1 => {
                 return Err(self.error_at(
                     k.span(),
                     "solver.predictor",

@@ -117,7 +117,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     for w in super::check::never_touched(&p, &out_dir.join("summary.json")) {
         eprintln!("warning: {w}");
     }
-    let coarse = match coarse {
+    let mut coarse = match coarse {
         Ok(c) => c,
         Err(e) => {
             let _ = edit_summary(&out_dir, |v| v["refinement"] = refinement("not run: the run on the problem's mesh failed".into(), &meshes));
@@ -127,7 +127,8 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     let load_factors: Vec<f64> = coarse.history.rows.iter().map(|r| r.load_factor).collect();
     let mut fines = Vec::with_capacity(levels);
     let mut files = coarse.files.clone();
-    let mut previous_states = std::sync::Arc::new(coarse.states.clone());
+    // (the states move on to the next level: the outcome keeps none)
+    let mut previous_states = std::sync::Arc::new(std::mem::take(&mut coarse.states));
     for level in 1..=levels {
         let mesh = next.take().expect("refined before the loop or in the level before");
         if level < levels {
@@ -140,10 +141,10 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         if !quiet {
             eprintln!("stamp run --refine: {status}");
         }
-        let this_mesh = mesh.mesh.clone();
+        // the level before starts this one's steps; this one the next level's
+        let previous = PreviousLevel { mesh: std::mem::replace(&mut previous_mesh, mesh.mesh.clone()), states: previous_states.clone() };
         let fine = build_on(&p, mesh).and_then(|setup| {
             let note = json!({ "level": level, "note": format!("the problem's mesh refined {}, driven through the load factors of ../summary.json, every step started from the solution on the mesh before", times(level)) });
-            let previous = PreviousLevel { mesh: std::mem::replace(&mut previous_mesh, this_mesh), states: previous_states.clone() };
             let opts = SolveOptions { quiet, no_table: true, targets: Some(load_factors.clone()), refinement: Some(note), caller_finishes: false, record_states: level < levels, previous: Some(previous) };
             solve_and_write(&p, setup, &dir, &opts)
         });

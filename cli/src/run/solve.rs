@@ -34,7 +34,6 @@ pub struct RunOutcome {
     pub states: Vec<(f64, Vec<f64>)>,
 }
 
-
 /// How [`solve_and_write`] runs beyond the problem file.
 #[derive(Debug, Clone, Default)]
 pub struct SolveOptions {
@@ -53,7 +52,8 @@ pub struct SolveOptions {
     /// Keep every converged state in [`RunOutcome::states`].
     pub record_states: bool,
     /// Start every load step from this run's solution (interpolated onto this mesh) instead of
-    /// the secant predictor, or the `[solver] predictor = "coarse"` solve.
+    /// the secant predictor; it takes precedence over `[solver] predictor = "coarse"`, whose
+    /// coarse setup is then not solved.
     pub previous: Option<super::coarse::PreviousLevel>,
 }
 
@@ -191,7 +191,6 @@ impl Progress {
     }
 
     /// `forces`: the punches' forces and travels, appended to the terse line.
-    #[allow(clippy::too_many_arguments)]
     fn step(&self, rep: &stamp::nonlinear::StepReport, path: f64, active: usize, penetration: f64, forces: &str) {
         let (step, t, iterations) = (rep.step, rep.load_factor, rep.iterations);
         *self.state.lock().unwrap() = (step, t);
@@ -349,9 +348,9 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         super::coarse::predict_from(&mut newton, previous.path_onto(&mesh.mesh, model.dofs.dofs_per_node()));
     } else if let Some(coarse) = coarse {
         if !quiet {
-            eprintln!("coarse predictor: solving on the coarse mesh ({} nodes) first", coarse.mesh.mesh.num_nodes());
+            eprintln!("coarse predictor: solving on the coarse mesh ({} nodes) first", coarse.setup.mesh.mesh.num_nodes());
         }
-        let (path, report) = super::coarse::solve_coarse(*coarse, &mesh, &targets);
+        let (path, report) = super::coarse::solve_coarse(*coarse, &targets);
         if !quiet || report.error.is_some() {
             eprintln!("{}", report.line());
         }
@@ -471,7 +470,9 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     progress.finish();
     drop(cx);
     summary.newton_iterations = total_iterations;
-    summary.failed_iterations = total_failed;
+    // every iteration not in a converged attempt: those of the steps that converged after cut-backs
+    // and of the attempts of a step that failed for good
+    summary.failed_iterations = newton.iterations_done().saturating_sub(total_iterations);
     // after a write failure the solve stopped on request: that is no failure of its own
     let surface_error = surface_error.or_else(|| surface_failure(p, &model.contacts));
     let solve_failure = if write_error.is_some() { None } else { surface_error.or(result.err()) };
@@ -483,6 +484,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         summary.steps.push(serde_json::json!({
             "load_factor": lf,
             "converged": false,
+            "failed_iterations": summary.failed_iterations.saturating_sub(total_failed),
             "error": e.to_string(),
         }));
     }
