@@ -15,8 +15,9 @@ const BASE: &str = CANTILEVER;
 /// A cylinder punch above the strip, for the punch keys.
 const PUNCH: &str = "\n[[punch]]\nname = \"roller\"\nshape = \"cylinder\"\npoint = [0.0, 50.0, 5.0]\naxis = [1.0, 0.0, 0.0]\nradius = 4.0\nmotion = [0.0, 0.0, -1.0]\n";
 
-/// The longest message we accept.
-const MAX_MESSAGE: usize = 400;
+/// The longest message we accept (the message, and under it the problem file's line: at most 60 of
+/// its characters).
+const MAX_MESSAGE: usize = 480;
 
 /// 1-based line of the first line of `text` that contains `needle`.
 fn line_of(text: &str, needle: &str) -> usize {

@@ -110,6 +110,9 @@ fn refused(case: &str, shipped: &str, edits: &[(&str, &str)], at: &str, wanted: 
     for (what, code, err) in [("run", code, &err), ("check", check.status.code(), &check_err)] {
         assert_eq!(code, Some(1), "{case} ({what}): {err}");
         assert!(err.contains(&format!("{case}.toml: ")) && err.contains(&format!("line {line}, column")), "{case} ({what}): not at line {line}: {err}");
+        // the line itself under the message
+        let shown = text.lines().nth(line - 1).unwrap().chars().take(20).collect::<String>();
+        assert!(err.contains(&format!("\n  {line} | {shown}")), "{case} ({what}): line {line} not shown: {err}");
         for w in wanted {
             assert!(err.contains(w), "{case} ({what}): no '{w}' in: {err}");
         }

@@ -732,17 +732,21 @@ fn toml_message(source: &str, e: &toml::de::Error) -> String {
     let what = quote_long(&what.join(" "), 300);
     let Some(span) = e.span() else { return what };
     let (line, col) = line_col_of(source, span.start);
-    let text = source.lines().nth(line - 1).unwrap_or("");
     let what = match key_at(source, line, col) {
         // our own checks may name the key already ("mesh.rectangle.n: ...")
         Some(key) if !what.starts_with(&key) => format!("{}: {what}", quote(&key)),
         _ => what,
     };
-    // a window of the line around the column
+    format!("line {line}, column {col}: {what}\n{}", source_window(source, line, col))
+}
+
+/// "  L | <the line around the column>": the problem file's line under an error (at most 60
+/// characters of it, from 30 before the column, control bytes hidden).
+fn source_window(source: &str, line: usize, col: usize) -> String {
+    let text = source.lines().nth(line.saturating_sub(1)).unwrap_or("");
     let skip = col.saturating_sub(30);
     let shown: String = text.chars().skip(skip).collect();
-    let shown = format!("{}{}", if skip > 0 { "..." } else { "" }, quote_long(&shown, 60));
-    format!("line {line}, column {col}: {what}\n  {line} | {shown}")
+    format!("  {line} | {}{}", if skip > 0 { "..." } else { "" }, quote_long(&shown, 60))
 }
 
 /// The dotted key whose value sits at (line, column), for toml errors, which give only a place:
@@ -861,7 +865,7 @@ impl Problem {
     /// An input error located at `span`, naming `key`.
     pub fn error_at(&self, span: std::ops::Range<usize>, key: &str, message: impl std::fmt::Display) -> StampError {
         let (line, col) = self.line_col(span.start);
-        StampError::Input { file: self.path.display().to_string(), message: format!("line {line}, column {col}: {key}: {message}") }
+        StampError::Input { file: self.path.display().to_string(), message: format!("line {line}, column {col}: {key}: {message}\n{}", source_window(&self.source, line, col)) }
     }
 
     /// An error in the expression `psi` at its 1-based character `column`: located in the file
