@@ -5,6 +5,7 @@
     /usr/bin/python3 verification/3d/side_by_side.py                 # the default sequences
     /usr/bin/python3 verification/3d/side_by_side.py --stamp-n 10 20 40 80 160 --getfem-n 6 8 12 16 24
     /usr/bin/python3 verification/3d/side_by_side.py --stamp-surfaces 4 --stamp-n 20 40 80 160 --getfem-n 12 16 24 32
+    /usr/bin/python3 verification/3d/side_by_side.py --stamp-predictor coarse --stamp-n 20 40 80 100
 
 Needs GetFEM for the Debian Python (apt-get install -y python3-getfem). Not part of the test suite.
 
@@ -35,11 +36,13 @@ TOML = os.path.join(REPO, "meshes", "sphere-ss-displacement.toml")
 SIDE = 20.0
 
 
-def run_stamp(exe, n, workdir, extra="", surfaces=2):
+def run_stamp(exe, n, workdir, extra="", surfaces=2, predictor="secant"):
     """Run stamp on an n x n quarter mesh with `surfaces` surfaces through the thickness ([plate]
-    surfaces); return (wall time, force at travel 0.9, unknowns)."""
+    surfaces) and [solver] predictor; return (wall time, force at travel 0.9, unknowns)."""
     text = open(TOML).read()
     text = text.replace("n = [10, 10]", "n = [%d, %d]" % (n, n)).replace("plot = true", "plot = false")
+    if predictor != "secant":
+        text = text.replace("[solver]\n", "[solver]\npredictor = \"%s\"\n" % predictor, 1)
     if surfaces != 2:
         extra = (extra + "\n" if extra else "") + "surfaces = %d" % surfaces
     if extra:
@@ -117,6 +120,7 @@ def main():
     ap.add_argument("--stamp", default=os.path.join(REPO, "target", "release", "stamp"))
     ap.add_argument("--stamp-n", type=int, nargs="+", default=[10, 20, 40, 80])
     ap.add_argument("--stamp-surfaces", type=int, default=2, help="[plate] surfaces of stamp's runs (2: the paper's plate)")
+    ap.add_argument("--stamp-predictor", default="secant", choices=["secant", "coarse"], help="[solver] predictor of stamp's runs (coarse: every step from the mesh with half the n)")
     ap.add_argument("--getfem-n", type=int, nargs="+", default=[6, 8, 12, 16])
     ap.add_argument("--nz", type=int, default=2)
     ap.add_argument("--penalty", type=float, default=1e6)
@@ -127,7 +131,7 @@ def main():
     work = tempfile.mkdtemp(prefix="side_by_side_")
     st = []
     for n in a.stamp_n:
-        w, f, u = run_stamp(a.stamp, n, work, surfaces=a.stamp_surfaces)
+        w, f, u = run_stamp(a.stamp, n, work, surfaces=a.stamp_surfaces, predictor=a.stamp_predictor)
         st.append((n, w, f, u))
         print("stamp  n = %4d: %7d unknowns, %8.2f s, force %.4f" % (n, u, w, f), flush=True)
     gf = []
