@@ -337,6 +337,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         let mut first = f64::NAN;
         let mut last_correction = f64::INFINITY;
         let mut first_energy = f64::NAN;
+        // the first correction's energy of this solve, kept through the restarts after a
+        // multiplier update or an active-set change (which reset first_energy)
+        let mut solve_first_energy = f64::NAN;
         let mut last_energy = f64::INFINITY;
         let debug = std::env::var_os("STAMP_DEBUG").is_some();
         let mut scaled = if s.line_search_steps > 0 { vec![0.0; du.len()] } else { Vec::new() };
@@ -417,7 +420,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             // first: Newton has converged quadratically, and a further iteration can only confirm
             // the stall (the penalty's |R| floor lies above rel_tol, and on fine meshes above
             // floor_tol)
-            let settled = it > 1 && ev.residual_norm <= s.loose_tol * ev.force_scale && last_energy <= s.energy_tol * first_energy;
+            let settled = it > 1 && ev.residual_norm <= s.loose_tol * ev.force_scale && last_energy <= s.energy_tol * first_energy.max(solve_first_energy);
             if ev.residual_norm <= tol || (stalled && ev.residual_norm <= s.floor_tol * ev.force_scale) || settled || fixed || energy {
                 if ev.active_changes == 0 {
                     if first_energy.is_finite() {
@@ -488,6 +491,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             last_energy = du.iter().zip(p.residual()).map(|(a, b)| a * b).sum::<f64>().abs();
             if first_energy.is_nan() {
                 first_energy = last_energy;
+            }
+            if solve_first_energy.is_nan() {
+                solve_first_energy = last_energy;
             }
             // backtracking line search on |R|: keeps a far-off predictor from pushing the body deep
             // into the punch (and the active set from swinging wholesale)
