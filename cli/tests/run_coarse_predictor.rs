@@ -39,8 +39,8 @@ fn same_forces(a: &[(f64, usize)], b: &[(f64, usize)], tol: f64) -> (usize, usiz
 
 #[test]
 fn the_rectangle_with_half_its_n_starts_every_step_and_saves_iterations() {
-    // meshes/sphere-ss-displacement.toml on 40 x 40 (measured: 35 Newton iterations with the
-    // secant predictor, 29 from the 20 x 20 mesh's solution, which took 40 of its own)
+    // meshes/sphere-ss-displacement.toml on 40 x 40 (measured: 33 Newton iterations with the
+    // secant predictor, 28 from the 20 x 20 mesh's solution, which took 32 of its own)
     let n40 = [("n = [10, 10]", "n = [40, 40]"), ("plot = true", "plot = false")];
     let secant = run(&variant("coarse-off", "sphere-ss-displacement.toml", &n40), "coarse-off-out");
     let mut edits = n40.to_vec();
@@ -65,7 +65,7 @@ fn the_rectangle_with_half_its_n_starts_every_step_and_saves_iterations() {
 #[test]
 fn two_independent_gmsh_meshes_of_a_curved_plate() {
     // meshes/disk-clamped.toml on gmsh's lc = 1 triangles, started from the shipped lc = 2 mesh:
-    // neither nested nor with the same boundary (the arc's chords differ), measured 54 Newton
+    // neither nested nor with the same boundary (the arc's chords differ), measured 53 Newton
     // iterations with the secant predictor against 25
     let fine = [("file = \"disk-clamped.msh\"", "file = \"disk-clamped-lc1.msh\"")];
     let secant = run(&variant("disk-secant", "disk-clamped.toml", &fine), "disk-secant-out");
@@ -83,7 +83,7 @@ fn two_independent_gmsh_meshes_of_a_curved_plate() {
 #[test]
 fn refine_starts_every_finer_mesh_from_the_one_before() {
     // --refine 2 from 10 x 10: its 20 x 20 and 40 x 40 runs give what plain runs on those meshes
-    // give, in fewer iterations (measured 36 and 29 against 40 and 35)
+    // give, in fewer iterations (measured 30 and 28 against 32 and 33)
     let problem = variant("refine-nested", "sphere-ss-displacement.toml", &[("plot = true", "plot = false")]);
     let out = temp_dir("refine-nested-out");
     let (code, err) = stamp_run(&problem, &out, &["--refine=2"]);
