@@ -352,16 +352,10 @@ impl ContactPair {
         }
     }
 
-    /// Whether the load step that starts now starts from an outside prediction of its answer
-    /// (see `predicted_step`); called after [`start_step`](Self::start_step).
-    pub fn start_predicted(&mut self, predicted: bool) {
+    /// Forget the cycling history (at the start of a load step); `predicted`: the step starts from
+    /// an outside prediction of its answer (see `predicted_step`).
+    pub fn start_step(&mut self, predicted: bool) {
         self.predicted_step = predicted;
-    }
-
-    /// Forget the cycling history (at the start of a load step).
-    pub fn start_step(&mut self) {
-        // from the secant predictor unless start_predicted says otherwise
-        self.predicted_step = false;
         self.flips.fill(0);
         self.frozen.fill(false);
         self.step_start = true;
@@ -875,7 +869,7 @@ mod entry_tests {
     fn the_first_iteration_of_a_load_step_takes_only_the_deepest_tenth() {
         let mut p = pair(0.5);
         evaluate(&mut p, [0.0, 0.0, 0.0, 1e-3]);
-        p.start_step();
+        p.start_step(false);
         // trials -9.99, -5.99, -3.99 against 0.9 * -9.99: only the first enters
         let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 1e-3]);
         assert_eq!((changes, active), (3, vec![true, false, false, true]));
@@ -889,8 +883,7 @@ mod entry_tests {
         // would take the deepest point only and count the others as changes): every
         // penetrating point is in the set it records
         let mut p = pair(0.5);
-        p.start_step();
-        p.start_predicted(true);
+        p.start_step(true);
         let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]);
         assert_eq!((changes, active), (0, vec![true, true, true, false]));
         // later evaluations of the step too: a point that starts penetrating enters at once
@@ -899,11 +892,9 @@ mod entry_tests {
         // a step from the secant predictor damps as before: of the new penetrations (trials
         // -9.99, -5.99, -3.99 against 0.9 * -9.99) only the deepest enters
         let mut p = pair(0.5);
-        p.start_step();
-        p.start_predicted(true);
+        p.start_step(true);
         assert_eq!(evaluate(&mut p, [1.0, 0.0, 0.0, 0.0]), (0, vec![true, false, false, false]));
-        p.start_step();
-        p.start_predicted(false);
+        p.start_step(false);
         let (changes, active) = evaluate(&mut p, [1.0, 1.0, 0.6, 0.4]);
         assert_eq!((changes, active), (3, vec![true, true, false, false]));
     }

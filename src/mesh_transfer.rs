@@ -11,7 +11,7 @@
 //! Used by [`crate::coarse_path`] to start the load steps of a fine mesh from the solution on a
 //! coarse one.
 
-use crate::mesh::{bilinear, QuadMesh};
+use crate::mesh::{bilinear, bilinear_point, inverse_bilinear, QuadMesh};
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
@@ -27,38 +27,14 @@ pub struct Prolongation {
     farthest_outside: (usize, f64),
 }
 
-/// (s, t) in [-1, 1]^2 of the point `p` in the bilinear cell `x` (Newton on the bilinear map; a
-/// point outside the cell gives a value outside the square), and the distance from the square.
+/// (s, t) of the point `p` in the bilinear cell `x` ([`inverse_bilinear`]; a point outside the
+/// cell gives a value outside the square) and how far outside the square it lies; infinitely far
+/// where the map cannot be inverted (a degenerate cell, a point far off).
 fn local_coordinates(x: &[[f64; 2]; 4], p: [f64; 2]) -> ([f64; 2], f64) {
-    let (mut s, mut t) = (0.0f64, 0.0f64);
-    for _ in 0..30 {
-        let (n, dn) = bilinear(s, t);
-        let mut r = [-p[0], -p[1]];
-        let mut j = [[0.0; 2]; 2];
-        for a in 0..4 {
-            for i in 0..2 {
-                r[i] += n[a] * x[a][i];
-                j[i][0] += dn[a][0] * x[a][i];
-                j[i][1] += dn[a][1] * x[a][i];
-            }
-        }
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        if det == 0.0 || !det.is_finite() {
-            break;
-        }
-        let ds = (j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let dt = (-j[1][0] * r[0] + j[0][0] * r[1]) / det;
-        s -= ds;
-        t -= dt;
-        if ds.abs() + dt.abs() < 1e-13 {
-            break;
-        }
+    match inverse_bilinear(x, p) {
+        Some([s, t]) => ([s, t], (s.abs() - 1.0).max(0.0) + (t.abs() - 1.0).max(0.0)),
+        None => ([0.0; 2], f64::INFINITY),
     }
-    if !(s.is_finite() && t.is_finite()) {
-        // a degenerate cell: never the one that holds the point
-        return ([0.0; 2], f64::INFINITY);
-    }
-    ([s, t], (s.abs() - 1.0).max(0.0) + (t.abs() - 1.0).max(0.0))
 }
 
 impl Prolongation {
@@ -96,11 +72,11 @@ impl Prolongation {
                 }
             }
             let (outside, c, [s, t]) = best.expect("a coarse mesh has cells");
-            let (n, _) = bilinear(s.clamp(-1.0, 1.0), t.clamp(-1.0, 1.0));
+            let clamped = [s.clamp(-1.0, 1.0), t.clamp(-1.0, 1.0)];
+            let (n, _) = bilinear(clamped[0], clamped[1]);
             if outside > 0.0 {
                 // the distance from the point of the cell it was clamped to
-                let x = coarse.cell_coords(c);
-                let q = (0..2).map(|i| (0..4).map(|a| n[a] * x[a][i]).sum::<f64>()).collect::<Vec<f64>>();
+                let q = bilinear_point(&coarse.cell_coords(c), clamped);
                 let d = (q[0] - p[0]).hypot(q[1] - p[1]);
                 if d > farthest_outside.1 {
                     farthest_outside = (j, d);

@@ -355,14 +355,9 @@ impl<E: Element> NonlinearProblem for Model<E> {
     fn update_active_set(&mut self) -> usize {
         self.contacts.iter_mut().map(|c| c.update_active_set()).sum()
     }
-    fn start_step(&mut self) {
+    fn start_step(&mut self, predicted: bool) {
         for c in self.contacts.iter_mut() {
-            c.start_step();
-        }
-    }
-    fn start_predicted(&mut self, predicted: bool) {
-        for c in self.contacts.iter_mut() {
-            c.start_predicted(predicted);
+            c.start_step(predicted);
         }
     }
     /// The augmented-Lagrangian update of [`end_step`](Self::end_step), at the last evaluation's

@@ -57,13 +57,11 @@ pub trait NonlinearProblem {
     fn update_active_set(&mut self) -> usize {
         0
     }
-    /// Called before the first iteration of every load step.
-    fn start_step(&mut self) {}
-    /// Called after [`start_step`](Self::start_step) with true when the step starts from an
-    /// outside prediction of its answer ([`NewtonRaphson::predictor`]: the solution on a coarse
-    /// mesh) rather than from the extrapolated path: the problem may trust the start (the contact
-    /// pairs then let every penetrating point into the active set at once).
-    fn start_predicted(&mut self, _predicted: bool) {}
+    /// Called before the first iteration of every load step; `predicted` is true when the step
+    /// starts from an outside prediction of its answer ([`NewtonRaphson::predictor`]: the
+    /// solution on a coarse mesh) rather than from the extrapolated path: the problem may trust
+    /// the start (the contact pairs then let every penetrating point into the active set at once).
+    fn start_step(&mut self, _predicted: bool) {}
     /// Called after a load step converged. Returning true asks for the step to be solved again at
     /// the same load (an augmented-Lagrangian update, say).
     fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
@@ -302,7 +300,7 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// The start of each load step, when given: called with (converged steps so far, load factor
     /// of the last converged state, load factor of the step, the start to set); true when it set
     /// the start (then used instead of the secant extrapolation, see
-    /// [`NonlinearProblem::start_predicted`]), false to keep the extrapolation. A
+    /// [`NonlinearProblem::start_step`]), false to keep the extrapolation. A
     /// [`crate::coarse_path::CoarsePath`], say. Not asked for the retries of a step after
     /// [`PREDICTED_ATTEMPTS`] failed attempts in a row.
     pub predictor: Option<Box<dyn FnMut(usize, f64, f64, &mut [f64]) -> bool>>,
@@ -584,8 +582,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 let trusted = cutbacks_in_row < PREDICTED_ATTEMPTS;
                 let predicted = trusted && self.predictor.as_mut().is_some_and(|predict| predict(summary.steps, t, step_t, &mut trial));
                 p.apply_prescribed(&mut trial, step_t);
-                p.start_step();
-                p.start_predicted(predicted);
+                p.start_step(predicted);
                 // multiplier updates of this attempt, inside Newton and by re-solves
                 let mut updates = 0;
                 // iterations of the re-solves of this step before the last one
@@ -658,8 +655,9 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         }
                     }
                     Err((reason, residual, tolerance)) => {
-                        failed_iterations += self.iterations_done - attempt_start;
-                        summary.failed_iterations += self.iterations_done - attempt_start;
+                        let spent = self.iterations_done - attempt_start;
+                        failed_iterations += spent;
+                        summary.failed_iterations += spent;
                         p.restore();
                         cutbacks_in_row += 1;
                         summary.cutbacks += 1;

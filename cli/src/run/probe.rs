@@ -32,7 +32,7 @@ use super::units::Units;
 use serde::Deserialize;
 use stamp::contact::ContactPair;
 use stamp::io::write_string_atomically;
-use stamp::mesh::{bilinear, QuadMesh};
+use stamp::mesh::{bilinear, inverse_bilinear, QuadMesh};
 use stamp::Result;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
@@ -83,43 +83,6 @@ pub fn check_probes(p: &Problem, probes: &[Spanned<ProbeSpec>]) -> Result<()> {
 
 // ---------------------------------------------------------------------------------------------
 // point location
-
-/// Invert the isoparametric map of the bilinear quadrilateral `x` (corners in the order of
-/// [`bilinear`]) at `p` by Newton's method from the centre. Returns (xi1, xi2), which lie in
-/// [-1, 1]^2 when `p` is inside; None when Newton does not converge (a degenerate cell, or a point
-/// far outside).
-pub fn inverse_bilinear(x: &[[f64; 2]; 4], p: [f64; 2]) -> Option<[f64; 2]> {
-    let size = (0..4).map(|a| (x[a][0] - x[(a + 2) % 4][0]).hypot(x[a][1] - x[(a + 2) % 4][1])).fold(0.0, f64::max);
-    let mut xi = [0.0, 0.0];
-    for _ in 0..30 {
-        let (n, dn) = bilinear(xi[0], xi[1]);
-        let mut r = [-p[0], -p[1]];
-        let mut j = [[0.0; 2]; 2];
-        for a in 0..4 {
-            for i in 0..2 {
-                r[i] += n[a] * x[a][i];
-                for k in 0..2 {
-                    j[i][k] += dn[a][k] * x[a][i];
-                }
-            }
-        }
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        if det.abs() <= 1e-14 * size * size || !det.is_finite() {
-            return None;
-        }
-        let d = [(j[1][1] * r[0] - j[0][1] * r[1]) / det, (-j[1][0] * r[0] + j[0][0] * r[1]) / det];
-        xi = [xi[0] - d[0], xi[1] - d[1]];
-        if xi.iter().any(|v| !v.is_finite() || v.abs() > 1e3) {
-            return None;
-        }
-        // Newton converges quadratically: after a correction below 1e-10 the error is round-off
-        // (an absolute 1e-14 is out of reach for small cells far from the origin)
-        if d[0].abs().max(d[1].abs()) < 1e-10 {
-            return Some(xi);
-        }
-    }
-    None
-}
 
 /// Tolerance on |xi| - 1 for a point to count as inside a cell (points on edges and nodes).
 const INSIDE_TOL: f64 = 1e-9;
@@ -473,40 +436,6 @@ pub fn choose_evenly(path: &[f64], n: usize) -> Vec<usize> {
 mod tests {
     use super::*;
 
-    fn skewed() -> [[f64; 2]; 4] {
-        [[0.0, 0.0], [3.0, 0.5], [2.5, 2.0], [-0.5, 1.5]]
-    }
-
-    /// The forward map at xi.
-    fn map(x: &[[f64; 2]; 4], xi: [f64; 2]) -> [f64; 2] {
-        let (n, _) = bilinear(xi[0], xi[1]);
-        let mut p = [0.0; 2];
-        for a in 0..4 {
-            for i in 0..2 {
-                p[i] += n[a] * x[a][i];
-            }
-        }
-        p
-    }
-
-    #[test]
-    fn inverse_map_recovers_local_coordinates_of_a_distorted_quad() {
-        let x = skewed();
-        for xi in [[0.3, -0.7], [-1.0, -1.0], [1.0, 1.0], [0.999, -0.2], [-0.5, 0.95]] {
-            let back = inverse_bilinear(&x, map(&x, xi)).expect("converges");
-            assert!((back[0] - xi[0]).abs() < 1e-12 && (back[1] - xi[1]).abs() < 1e-12, "{xi:?} -> {back:?}");
-        }
-        // a small cell far from the origin: round-off in x is large against the cell
-        let far = x.map(|c| [1.0e3 + 1e-3 * c[0], -2.0e3 + 1e-3 * c[1]]);
-        let back = inverse_bilinear(&far, map(&far, [0.25, -0.5])).expect("converges far from the origin");
-        assert!((back[0] - 0.25).abs() < 1e-8 && (back[1] + 0.5).abs() < 1e-8, "{back:?}");
-        // a point outside maps to |xi| > 1
-        let out = inverse_bilinear(&x, [5.0, 5.0]).map(|v| v[0].abs().max(v[1].abs()));
-        assert!(out.is_none_or(|m| m > 1.0), "{out:?}");
-        // a degenerate (zero-area) cell is refused
-        assert!(inverse_bilinear(&[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]], [1.0, 0.0]).is_none());
-    }
-
     #[test]
     fn locator_finds_the_cell_and_refuses_points_outside() {
         // a 7 x 5 rectangle with its interior nodes moved, so cells are distorted
@@ -521,7 +450,7 @@ mod tests {
         for c in 0..mesh.num_cells() {
             let x = mesh.cell_coords(c);
             for xi in [[0.1, 0.2], [-0.8, 0.6], [0.5, -0.9]] {
-                let p = map(&x, xi);
+                let p = stamp::mesh::bilinear_point(&x, xi);
                 let (found, back) = loc.locate(p).unwrap_or_else(|| panic!("{p:?} in cell {c} not found"));
                 assert_eq!(found, c, "{p:?}");
                 assert!((back[0] - xi[0]).abs() < 1e-10 && (back[1] - xi[1]).abs() < 1e-10);
