@@ -51,6 +51,10 @@ pub struct Model<E: Element> {
     /// Per force-driven punch: (index in `contacts`, number of candidate points) the pattern was
     /// bordered for.
     border: Vec<(usize, usize)>,
+    /// The punches with an integrated discretisation (index in `contacts`, their
+    /// [`ContactPair::coupling_version`]) the nodal pattern couples (see
+    /// [`ContactPair::coupled_nodes`]).
+    coupled: Vec<(usize, u64)>,
     assembler: Assembler,
     /// Internal + contact force over all dofs at the last evaluation (reactions at prescribed dofs).
     force: Vec<f64>,
@@ -98,6 +102,7 @@ impl<E: Element> Model<E> {
             nodal_pattern: None,
             pattern,
             border: Vec::new(),
+            coupled: Vec::new(),
             assembler,
             energy: 0.0,
             saved: Vec::new(),
@@ -150,8 +155,24 @@ impl<E: Element> Model<E> {
     }
 
     /// Number each force-driven punch's unknown and border the pattern for them (when they
-    /// changed).
+    /// changed), and couple the nodes of the integrated punches' patches in it.
     fn sync_drives(&mut self) {
+        let coupled: Vec<(usize, u64)> = self.contacts.iter().enumerate().filter(|(_, c)| c.face().is_some()).map(|(i, c)| (i, c.coupling_version())).collect();
+        if coupled != self.coupled {
+            let groups: Vec<Vec<usize>> = coupled.iter().flat_map(|&(i, _)| self.contacts[i].coupled_nodes()).collect();
+            let element = &self.element;
+            let nodal = SparsePattern::coupled(&self.dofs, element.num_elements(), element.nodes_per_element(), |e| element.element_nodes(e).to_vec(), &groups)
+                .expect("the element pattern was built before; contact points are nodes of the model");
+            self.nodal_pattern = None;
+            self.pattern = nodal;
+            self.coupled = coupled;
+            // border again below, and size the values
+            self.border.clear();
+            self.values = vec![0.0; self.pattern.nnz()];
+            if !self.preconditioner.is_empty() {
+                self.preconditioner = vec![0.0; self.pattern.nnz()];
+            }
+        }
         let nd = self.dofs.num_dofs();
         let mut sig = Vec::new();
         for (i, c) in self.contacts.iter_mut().enumerate() {
@@ -266,6 +287,11 @@ impl<E: Element> NonlinearProblem for Model<E> {
             };
             for pair in self.contacts.iter_mut() {
                 changes += if with_tangent { pair.evaluate(u, t, &mut self.force, Some(&mut add)) } else { pair.evaluate(u, t, &mut self.force, None) };
+                // an integrated punch whose contact reached points the pattern does not couple:
+                // couple them from the next evaluation on (this tangent lacks those entries)
+                if pair.needs_coupling() {
+                    pair.extend_coupling();
+                }
                 contact_sq += pair.force_norm().powi(2);
                 if let Some(f) = &pair.drive {
                     ext_sq += (t * f.force).powi(2);

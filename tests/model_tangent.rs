@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive};
+use stamp::contact::{ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
@@ -27,6 +27,12 @@ fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
 }
 
 fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed: u64, drive: Option<[f64; 3]>) {
+    check_with(surface, kin, seed, drive, false)
+}
+
+/// `integrated`: the integrated discretisation (each node's weighted gap over its cells), whose
+/// tangent couples the nodes of neighbouring cells.
+fn check_with(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed: u64, drive: Option<[f64; 3]>, integrated: bool) {
     let mut mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 3, 3).unwrap();
     // distort the interior nodes
     let mut rng = Lcg(seed);
@@ -51,6 +57,10 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
         Kinematics::Linear => ContactKinematics::Shallow { direction: [0.0, 0.0, 1.0] },
     };
     let mut pair = ContactPair::new("punch", surface, points, 3.0e3, ck);
+    if integrated {
+        let all: Vec<Option<usize>> = (0..mesh.num_nodes()).map(Some).collect();
+        pair = pair.with_face(ContactFace::new(&mesh.coords, &mesh.cells, &all, mesh.num_nodes()).unwrap()).unwrap();
+    }
     // every penetrating point active in the one evaluation (no damped entry, which starts an
     // empty set at the deepest point only)
     pair.entry_fraction = 0.0;
@@ -73,6 +83,12 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
     }
     model.apply_prescribed(&mut u, 1.0);
     model.evaluate(&u, 1.0, true).unwrap();
+    if integrated {
+        // the first evaluation found the points in contact, which the pattern did not couple
+        // yet: the model couples them from the next evaluation on
+        model.evaluate(&u, 1.0, true).unwrap();
+        assert!(!model.contacts[0].needs_coupling());
+    }
     let active = model.contacts[0].state.iter().filter(|s| s.active).count();
     assert!(active >= 3, "the test state should have points in contact, has {active}");
     let k = dense(model.matrix());
@@ -165,4 +181,16 @@ fn model_tangent_with_cylinder_contact_matches_finite_differences() {
     let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
     check(Arc::new(c), Kinematics::Nonlinear, 12, None);
     check(Arc::new(Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap()), Kinematics::Linear, 13, None);
+}
+
+#[test]
+fn model_tangent_with_integrated_contact_matches_finite_differences() {
+    // the weighted gaps couple the nodes of neighbouring cells: those entries must be in the
+    // pattern and right, for a prescribed and a force-driven punch, exact and shallow kinematics
+    let s = || Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    check_with(Arc::new(s()), Kinematics::Nonlinear, 31, None, true);
+    check_with(Arc::new(s()), Kinematics::Nonlinear, 32, Some([0.3, -0.2, -1.0]), true);
+    check_with(Arc::new(s()), Kinematics::Linear, 33, Some([0.0, 0.0, -1.0]), true);
+    let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
+    check_with(Arc::new(c), Kinematics::Nonlinear, 34, None, true);
 }

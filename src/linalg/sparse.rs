@@ -25,6 +25,13 @@ pub struct SparsePattern {
 impl SparsePattern {
     /// Build the pattern of the matrix coupling all dofs of nodes that share an element.
     pub fn new(dofs: &DofMap, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>) -> Result<Self> {
+        Self::coupled(dofs, num_elements, nodes_per_element, element_nodes, &[])
+    }
+
+    /// The same, also coupling all dofs of the nodes of each group of `couplings` (an integrated
+    /// contact's tangent couples the nodes of two cells that share a node: see
+    /// [`crate::contact::ContactFace`]). Element slots are those of the larger pattern.
+    pub fn coupled(dofs: &DofMap, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>, couplings: &[Vec<usize>]) -> Result<Self> {
         let nn = dofs.num_nodes();
         let dpn = dofs.dofs_per_node();
         let npe = nodes_per_element;
@@ -44,7 +51,16 @@ impl SparsePattern {
             }
             conn.extend_from_slice(&nodes);
         }
-        if let Some(orphan) = (0..nn).find(|&i| count[i] == 1) {
+        let orphan = (0..nn).find(|&i| count[i] == 1);
+        for g in couplings {
+            for &a in g {
+                if a >= nn {
+                    return Err(StampError::Mesh(format!("a coupling refers to node {a}, the model has {nn}")));
+                }
+                count[a] += g.len() - 1;
+            }
+        }
+        if let Some(orphan) = orphan {
             return Err(StampError::Mesh(format!(
                 "node {orphan} belongs to no element, so nothing holds it (a stray point in the mesh file?)"
             )));
@@ -63,6 +79,16 @@ impl SparsePattern {
             let nodes = &conn[e * npe..(e + 1) * npe];
             for &a in nodes {
                 for &b in nodes {
+                    if a != b {
+                        adj[fill[a]] = b;
+                        fill[a] += 1;
+                    }
+                }
+            }
+        }
+        for g in couplings {
+            for &a in g {
+                for &b in g {
                     if a != b {
                         adj[fill[a]] = b;
                         fill[a] += 1;

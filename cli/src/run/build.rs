@@ -33,9 +33,9 @@
 use super::mesh::{group_error, MeshData};
 use super::rigid_modes::num;
 use super::plate_model::{Layout, Plate};
-use super::problem::{ContactKinematicsSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape};
+use super::problem::{ContactKinematicsSpec, ContactSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape};
 use nalgebra::Vector3;
-use stamp::contact::{automatic_eps_reg, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
+use stamp::contact::{automatic_eps_reg, ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
 use stamp::model::Model;
 use stamp::nonlinear::NewtonSettings;
@@ -412,6 +412,11 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
             },
         };
         let mut pair = ContactPair::new(name.clone(), surface.clone(), points, 1.0, ck);
+        if spec.contact.unwrap_or(DEFAULT_CONTACT) == ContactSpec::Integrated {
+            pair = integrated(pair, &mesh, spec.group.as_ref().map(|g| g.get_ref().as_str())).map_err(|e| p.error_at(pu.span(), &format!("{key}.contact"), e))?;
+            // the pattern couples the patches of the points within a thickness of the punch
+            pair.coupling_reach = 0.02 * h;
+        }
         let (eps_reg, eps_automatic) = match spec.eps_reg {
             Some(e) => (e.0, false),
             None => (automatic_eps_reg(young * h, le, pair.contact_gradient_norm()), true),
@@ -486,6 +491,32 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
     }
     settings.validate().map_err(|e| StampError::Input { file: p.path.display().to_string(), message: format!("[solver]: {e}") })?;
     Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, coarse: None })
+}
+
+/// The default of `[[punch]] contact` (see docs/design.md).
+pub const DEFAULT_CONTACT: ContactSpec = ContactSpec::Nodal;
+
+/// The pair with the integrated discretisation on the cells of `group` (a surface group; None:
+/// every cell).
+fn integrated(pair: ContactPair, mesh: &MeshData, group: Option<&str>) -> Result<ContactPair> {
+    let cells: Vec<[usize; 4]> = match group {
+        None => mesh.mesh.cells.clone(),
+        Some(g) => match mesh.surfaces.get(g) {
+            Some(cells) => cells.iter().map(|&c| mesh.mesh.cells[c]).collect(),
+            None => {
+                return Err(StampError::Problem(format!(
+                    "\"integrated\" integrates over the cells of the punch's group, but '{}' is not a surface group (use a surface group, or contact = \"nodal\")",
+                    stamp::quote(g)
+                )))
+            }
+        },
+    };
+    let mut point_of_node = vec![None; mesh.mesh.num_nodes()];
+    for (k, q) in pair.points.iter().enumerate() {
+        point_of_node[q.node] = Some(k);
+    }
+    let face = ContactFace::new(&mesh.mesh.coords, &cells, &point_of_node, pair.points.len())?;
+    pair.with_face(face)
 }
 
 /// The STL die of a punch: `file` relative to the problem file; errors name the problem file, the

@@ -600,6 +600,18 @@ pub struct PunchSpec {
     /// Default: exact for a nonlinear plate, shallow (along x3) for a linear one.
     #[serde(default)]
     pub kinematics: Option<ContactKinematicsSpec>,
+    /// How the constraint is discretised: "nodal" (the paper's collocation at the nodes) or
+    /// "integrated" (each node's weighted gap over its cells); default: see build.rs.
+    #[serde(default)]
+    pub contact: Option<ContactSpec>,
+}
+
+/// `[[punch]] contact`: the discretisation of the contact constraint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactSpec {
+    Nodal,
+    Integrated,
 }
 
 #[derive(Debug, Deserialize, Default)]

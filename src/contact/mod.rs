@@ -31,6 +31,11 @@ use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use std::sync::Arc;
 
+mod face;
+mod motion;
+pub use face::ContactFace;
+pub use motion::{ForceDrive, PunchMotion};
+
 /// How the constraint is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactKinematics {
@@ -40,121 +45,6 @@ pub enum ContactKinematics {
     /// along a fixed direction n, Psi(X) + (grad Psi(X) . n)(u . n). The force acts along n on the
     /// undeformed body and lambda is the pressure itself (eq. 3.9).
     Shallow { direction: [f64; 3] },
-}
-
-/// A punch pressed by a prescribed force instead of moved by a prescribed displacement: the force
-/// `force * t` (t the load factor) pushes the punch along the unit `direction`, and its rigid
-/// displacement s along `direction` is an unknown. `dof` is the index of s in the full unknown
-/// vector; [`crate::model::Model`] assigns it (after the nodal dofs).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ForceDrive {
-    pub direction: [f64; 3],
-    pub force: f64,
-    pub dof: usize,
-}
-
-impl ForceDrive {
-    /// A force `force` (at load factor 1) along `direction` (normalised here; must be non-zero).
-    pub fn new(direction: [f64; 3], force: f64) -> crate::Result<Self> {
-        let n = Vector3::from(direction);
-        let len = n.norm();
-        if !(len > 0.0 && len.is_finite() && force.is_finite()) {
-            return Err(crate::StampError::Problem(format!("a force-driven punch needs a finite, non-zero direction and a finite force, got {direction:?} and {force}")));
-        }
-        Ok(ForceDrive { direction: (n / len).into(), force, dof: usize::MAX })
-    }
-}
-
-/// How a displacement-driven punch moves with the load factor t. The punch position is data, not
-/// an unknown: the model only evaluates [`displacement`](PunchMotion::displacement) at each t.
-#[derive(Debug, Clone, PartialEq)]
-pub enum PunchMotion {
-    /// t times this displacement (the displacement at load factor 1).
-    Linear([f64; 3]),
-    /// Piecewise linear in t through the points (t_k, d_k), t strictly increasing from t_0 = 0
-    /// with d_0 = 0 (see [`PunchMotion::path`]); held at the last displacement beyond the last t,
-    /// and at zero below 0.
-    Path(Vec<(f64, [f64; 3])>),
-}
-
-impl From<[f64; 3]> for PunchMotion {
-    fn from(m: [f64; 3]) -> Self {
-        PunchMotion::Linear(m)
-    }
-}
-
-impl Default for PunchMotion {
-    fn default() -> Self {
-        PunchMotion::Linear([0.0; 3])
-    }
-}
-
-impl PunchMotion {
-    /// A path through `rows` (t, displacement). The rows' t must be finite and strictly
-    /// increasing, the first at least 0; when the first t is 0 its displacement must be zero (the
-    /// punch starts where its geometry puts it), and when it is above 0 the path starts at (0, 0)
-    /// implicitly. The error says what is wrong with which row (0-based).
-    pub fn path(rows: &[(f64, [f64; 3])]) -> Result<PunchMotion, String> {
-        if rows.is_empty() {
-            return Err("a path needs at least one row [t, d1, d2, d3]".into());
-        }
-        for (k, (t, d)) in rows.iter().enumerate() {
-            if !(t.is_finite() && d.iter().all(|x| x.is_finite())) {
-                return Err(format!("row {k}: every number must be finite"));
-            }
-            if k == 0 && *t < 0.0 {
-                return Err(format!("row 0: the load factor t = {t} must be at least 0"));
-            }
-            if k == 0 && *t == 0.0 && *d != [0.0; 3] {
-                return Err("row 0: at t = 0 the displacement must be [0, 0, 0] (place the punch by its geometry; the path starts there)".into());
-            }
-            if k > 0 && !(*t > rows[k - 1].0) {
-                return Err(format!("row {k}: the load factors must increase strictly, but t = {t} follows t = {}", rows[k - 1].0));
-            }
-        }
-        let mut points = Vec::with_capacity(rows.len() + 1);
-        if rows[0].0 > 0.0 {
-            points.push((0.0, [0.0; 3]));
-        }
-        points.extend_from_slice(rows);
-        Ok(PunchMotion::Path(points))
-    }
-
-    /// The punch displacement at load factor `t`.
-    pub fn displacement(&self, t: f64) -> [f64; 3] {
-        match self {
-            PunchMotion::Linear(m) => m.map(|x| x * t),
-            PunchMotion::Path(points) => {
-                let Some(k) = points.iter().position(|p| p.0 > t) else {
-                    return points.last().map_or([0.0; 3], |p| p.1);
-                };
-                if k == 0 {
-                    return points[0].1;
-                }
-                let ((t0, a), (t1, b)) = (points[k - 1], points[k]);
-                let s = (t - t0) / (t1 - t0);
-                [0, 1, 2].map(|i| a[i] + s * (b[i] - a[i]))
-            }
-        }
-    }
-
-    /// True when the punch never moves.
-    pub fn is_zero(&self) -> bool {
-        match self {
-            PunchMotion::Linear(m) => *m == [0.0; 3],
-            PunchMotion::Path(points) => points.iter().all(|p| p.1 == [0.0; 3]),
-        }
-    }
-
-    /// The direction in which the punch first moves, not normalised: the linear motion itself, or
-    /// the first non-zero displacement of a path (its approach: a die that comes down then slides
-    /// approaches along -x3). Zero for a punch that never moves.
-    pub fn approach(&self) -> [f64; 3] {
-        match self {
-            PunchMotion::Linear(m) => *m,
-            PunchMotion::Path(points) => points.iter().map(|p| p.1).find(|d| *d != [0.0; 3]).unwrap_or([0.0; 3]),
-        }
-    }
 }
 
 /// The default regularisation parameter: the penalty stiffness of a contact point per unit area and
@@ -290,7 +180,85 @@ pub struct ContactPair {
     /// iterations in 5 steps; docs/performance.md).
     hold_after_update: bool,
     /// The point kinematics of the last evaluation (scratch, reused).
-    kinematics_scratch: Vec<(f64, Vector3<f64>, f64, Option<Vector3<f64>>)>,
+    kinematics_scratch: Vec<Kinematics>,
+    /// The integrated discretisation's face ([`ContactFace`]); None: the paper's nodal collocation.
+    face: Option<ContactFace>,
+    /// The kinematics at the face's quadrature points at the last evaluation (integrated only).
+    site_scratch: Vec<Kinematics>,
+    /// The points that gave a tangent in the last evaluation (integrated only, scratch).
+    tangent_points: Vec<bool>,
+    /// Integrated only: the points whose patch the model's sparse pattern couples (see
+    /// [`coupled_nodes`](Self::coupled_nodes)). Coupling every candidate's patch would make the
+    /// factor of a large face several times denser, so only the points near contact are coupled,
+    /// and more when contact reaches points that are not ([`extend_coupling`](Self::extend_coupling)).
+    coupled: Vec<bool>,
+    /// Bumped whenever `coupled` grows (the model rebuilds its pattern then).
+    coupling_version: u64,
+    /// A point that gave a tangent in the last evaluation is not coupled: its tangent lost the
+    /// entries outside the pattern (an inexact Newton step) until the model couples it.
+    needs_coupling: bool,
+    /// A point is coupled once its gap (Psi / |grad Psi|) is at most this length (set by the
+    /// caller: the plate's thickness, say); default 0: only points in contact.
+    pub coupling_reach: f64,
+}
+
+/// Psi, its gradient with respect to the displacement of the point (or quadrature point), its
+/// derivative with respect to a force-driven punch's unknown s, and where the Hessian is taken
+/// (None: no curvature term, the shallow constraint).
+type Kinematics = (f64, Vector3<f64>, f64, Option<Vector3<f64>>);
+
+/// What the kinematics of a point of the face needs at one evaluation.
+struct SiteContext<'a> {
+    surface: &'a dyn ContactSurface,
+    kinematics: ContactKinematics,
+    /// The punch displacement (prescribed plus s n).
+    d: Vector3<f64>,
+    /// The prescribed part of it.
+    prescribed: Vector3<f64>,
+    /// A force-driven punch's direction n (zero otherwise) and its unknown s.
+    dn: Vector3<f64>,
+    s: f64,
+}
+
+impl SiteContext<'_> {
+    /// The kinematics of the point at reference position `x_ref` displaced by `disp`: the surface
+    /// is queried at x (exact kinematics) or at the reference position moved back by the
+    /// prescribed motion (shallow: linearised about it), and not again while the point stays
+    /// where it was (`at`).
+    fn kinematics(&self, x_ref: Vector3<f64>, disp: Vector3<f64>, at: &mut SurfaceAtPoint) -> Kinematics {
+        // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
+        crate::linalg::vector_state::clean_upper_vector_state();
+        let x = match self.kinematics {
+            ContactKinematics::Exact => x_ref + disp - self.d,
+            ContactKinematics::Shallow { .. } => x_ref - self.prescribed,
+        };
+        // (NaN at the start: never equal)
+        if x != at.x {
+            let (psi, grad) = self.surface.psi_and_gradient(&x);
+            *at = SurfaceAtPoint { x, psi, grad };
+        }
+        let SurfaceAtPoint { psi, grad: g, .. } = *at;
+        let dn = self.dn;
+        match self.kinematics {
+            ContactKinematics::Exact => (psi, g, -g.dot(&dn), Some(x)),
+            ContactKinematics::Shallow { direction } => {
+                // in the plate's displacement along n and in the punch's unknown s
+                let n = Vector3::from(direction);
+                let gn = g.dot(&n);
+                (psi + gn * disp.dot(&n) - g.dot(&dn) * self.s, n * gn, -g.dot(&dn), None)
+            }
+        }
+    }
+}
+
+/// How the constraint is discretised over the body's face.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactDiscretisation {
+    /// Psi at each node, weighted by its tributary area (the paper's collocation, eq. 3.8).
+    #[default]
+    Nodal,
+    /// The weighted gap of each node integrated over its cells ([`ContactFace`]).
+    Integrated,
 }
 
 /// The default [`ContactPair::entry_fraction`].
@@ -349,7 +317,85 @@ impl ContactPair {
             predicted_step: false,
             hold_after_update: false,
             kinematics_scratch: Vec::new(),
+            face: None,
+            site_scratch: Vec::new(),
+            tangent_points: Vec::new(),
+            coupled: vec![false; n],
+            coupling_version: 0,
+            needs_coupling: false,
+            coupling_reach: 0.0,
         }
+    }
+
+    /// Use the integrated discretisation on `face`, whose contact points are this pair's points
+    /// (in order): each point's weight becomes its area int N_i dA on the face.
+    pub fn with_face(mut self, face: ContactFace) -> crate::Result<Self> {
+        if face.num_points() != self.points.len() {
+            return Err(crate::StampError::Problem(format!("the contact face has {} points, the punch {}", face.num_points(), self.points.len())));
+        }
+        for (p, &a) in self.points.iter_mut().zip(&face.area) {
+            p.weight = a;
+        }
+        self.surface_at_points = vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; face.quadrature.len()];
+        self.face = Some(face);
+        Ok(self)
+    }
+
+    /// The discretisation of the constraint.
+    pub fn discretisation(&self) -> ContactDiscretisation {
+        if self.face.is_some() { ContactDiscretisation::Integrated } else { ContactDiscretisation::Nodal }
+    }
+
+    /// The integrated discretisation's face, if any.
+    pub fn face(&self) -> Option<&ContactFace> {
+        self.face.as_ref()
+    }
+
+    /// Groups of nodes whose dofs the contact tangent couples beyond the nodes of one cell: the
+    /// patch of each coupled point for the integrated discretisation (see [`ContactFace`]), none
+    /// for the nodal.
+    pub fn coupled_nodes(&self) -> Vec<Vec<usize>> {
+        match &self.face {
+            None => Vec::new(),
+            Some(f) => (0..self.points.len())
+                .filter(|&i| self.coupled[i])
+                .map(|i| f.patch(i).iter().map(|&k| self.points[k as usize].node).collect())
+                .collect(),
+        }
+    }
+
+    /// Changes whenever the set of [`coupled_nodes`](Self::coupled_nodes) grows.
+    pub fn coupling_version(&self) -> u64 {
+        self.coupling_version
+    }
+
+    /// A point gave a tangent at the last evaluation without being coupled.
+    pub fn needs_coupling(&self) -> bool {
+        self.needs_coupling
+    }
+
+    /// Couple every point that gave a tangent at the last evaluation and every point within
+    /// `coupling_reach` of the punch (its gap Psi / |grad Psi| at the last evaluation); true when
+    /// the set grew.
+    pub fn extend_coupling(&mut self) -> bool {
+        if self.face.is_none() {
+            return false;
+        }
+        let mut grew = false;
+        for (i, s) in self.state.iter().enumerate() {
+            let g = Vector3::from(s.grad).norm();
+            let near = g > 0.0 && s.psi / g <= self.coupling_reach;
+            let wanted = near || self.tangent_points.get(i).copied().unwrap_or(false) || s.lambda != 0.0;
+            if wanted && !self.coupled[i] {
+                self.coupled[i] = true;
+                grew = true;
+            }
+        }
+        if grew {
+            self.coupling_version += 1;
+        }
+        self.needs_coupling = false;
+        grew
     }
 
     /// Forget the cycling history (at the start of a load step); `predicted`: the step starts from
@@ -420,37 +466,53 @@ impl ContactPair {
         // penetration), in parallel. The surface is queried at x (exact kinematics) or at the
         // reference position moved back by the prescribed motion (shallow: linearised about it),
         // and not again while that point stays where it was.
+        // With the integrated discretisation the same is done at the face's quadrature points,
+        // and each point's kinematics is its weighted mean over its cells (see ContactFace).
         let mut kin = std::mem::take(&mut self.kinematics_scratch);
         kin.resize(self.points.len(), (0.0, Vector3::zeros(), 0.0, None));
-        let surface = &*self.surface;
-        let kinematics = self.kinematics;
-        let prescribed = Vector3::from(self.motion.displacement(t));
-        let s = drive.map(|f| u[f.dof]).unwrap_or(0.0);
-        (kin.par_iter_mut(), self.surface_at_points.par_iter_mut(), self.points.par_iter()).into_par_iter().with_min_len(512).for_each(|(out, at, p)| {
-            // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
-            crate::linalg::vector_state::clean_upper_vector_state();
-            let x_ref = Vector3::from(p.x_ref);
-            let disp = Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
-            let x = match kinematics {
-                ContactKinematics::Exact => x_ref + disp - d,
-                ContactKinematics::Shallow { .. } => x_ref - prescribed,
-            };
-            // (NaN at the start: never equal)
-            if x != at.x {
-                let (psi, grad) = surface.psi_and_gradient(&x);
-                *at = SurfaceAtPoint { x, psi, grad };
+        let mut sites = std::mem::take(&mut self.site_scratch);
+        let site = SiteContext {
+            surface: &*self.surface,
+            kinematics: self.kinematics,
+            d,
+            prescribed: Vector3::from(self.motion.displacement(t)),
+            dn,
+            s: drive.map(|f| u[f.dof]).unwrap_or(0.0),
+        };
+        let points = &self.points;
+        let displacement = |p: &ContactPoint| Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
+        match &self.face {
+            None => {
+                (kin.par_iter_mut(), self.surface_at_points.par_iter_mut(), points.par_iter()).into_par_iter().with_min_len(512).for_each(|(out, at, p)| {
+                    *out = site.kinematics(Vector3::from(p.x_ref), displacement(p), at);
+                });
             }
-            let SurfaceAtPoint { psi, grad: g, .. } = *at;
-            *out = match kinematics {
-                ContactKinematics::Exact => (psi, g, -g.dot(&dn), Some(x)),
-                ContactKinematics::Shallow { direction } => {
-                    // in the plate's displacement along n and in the punch's unknown s
-                    let n = Vector3::from(direction);
-                    let gn = g.dot(&n);
-                    (psi + gn * disp.dot(&n) - g.dot(&dn) * s, n * gn, -g.dot(&dn), None)
-                }
-            };
-        });
+            Some(face) => {
+                sites.resize(face.quadrature.len(), (0.0, Vector3::zeros(), 0.0, None));
+                (sites.par_iter_mut(), self.surface_at_points.par_iter_mut(), face.quadrature.par_iter()).into_par_iter().with_min_len(512).for_each(|(out, at, q)| {
+                    let (mut x_ref, mut disp) = (Vector3::zeros(), Vector3::zeros());
+                    for a in 0..4 {
+                        let p = &points[q.points[a] as usize];
+                        x_ref += Vector3::from(p.x_ref) * q.shape[a];
+                        disp += displacement(p) * q.shape[a];
+                    }
+                    *out = site.kinematics(x_ref, disp, at);
+                });
+                let sites = &sites;
+                kin.par_iter_mut().enumerate().with_min_len(512).for_each(|(i, out)| {
+                    let (mut psi, mut grad, mut grad_s) = (0.0, Vector3::zeros(), 0.0);
+                    for &(q, a) in face.of_point(i) {
+                        let w = face.quadrature[q as usize].weight * face.quadrature[q as usize].shape[a as usize];
+                        let (sp, sg, ss, _) = sites[q as usize];
+                        psi += w * sp;
+                        grad += sg * w;
+                        grad_s += w * ss;
+                    }
+                    let inv = 1.0 / face.area[i];
+                    *out = (psi * inv, grad * inv, grad_s * inv, None);
+                });
+            }
+        }
         // Damped growth of the active set (see `entry_fraction`): in an evaluation with a tangent,
         // an inactive point enters only where its trial multiplier is at or below entry_fraction
         // times the most negative trial of the inactive points
@@ -483,6 +545,11 @@ impl ContactPair {
         };
         // at most one point active before this evaluation: a change is a lone point swinging
         let lone = !first && self.last_active.iter().filter(|a| **a).count() <= 1;
+        let integrated = self.face.is_some();
+        if integrated {
+            self.tangent_points.clear();
+            self.tangent_points.resize(self.points.len(), false);
+        }
         for (k, p) in self.points.iter().enumerate() {
             let (psi, grad, grad_s, hess) = kin[k];
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
@@ -528,6 +595,11 @@ impl ContactPair {
                 continue;
             }
             any_tangent = true;
+            if integrated {
+                // forces and tangent from the quadrature points below
+                self.tangent_points[k] = true;
+                continue;
+            }
             let w = p.weight;
             for i in 0..3 {
                 force[p.dofs[i]] += w * lambda * grad[i];
@@ -554,7 +626,10 @@ impl ContactPair {
                     .filter(|(_, s)| Vector3::from(s.grad).norm() > 0.0)
                     .min_by(|a, b| (a.1.psi / Vector3::from(a.1.grad).norm()).total_cmp(&(b.1.psi / Vector3::from(b.1.grad).norm())))
                     .map(|(k, _)| k);
-                if let Some(k) = closest {
+                if let (Some(k), true) = (closest, integrated) {
+                    self.state[k].lambda = self.lambda_bar[k] + self.eps_reg * self.state[k].psi;
+                    self.tangent_points[k] = true;
+                } else if let Some(k) = closest {
                     let p = &self.points[k];
                     let g = Vector3::from(self.state[k].grad);
                     let lambda = self.lambda_bar[k] + self.eps_reg * self.state[k].psi;
@@ -579,6 +654,13 @@ impl ContactPair {
                 }
             }
         }
+        if integrated {
+            if with_tangent {
+                self.needs_coupling = self.tangent_points.iter().zip(&self.coupled).any(|(t, c)| *t && !*c);
+            }
+            self.add_integrated(&sites, &dn, force, add_tangent);
+        }
+        self.site_scratch = sites;
         if first {
             self.initialized = true;
         }
@@ -588,6 +670,97 @@ impl ContactPair {
         }
         self.kinematics_scratch = kin;
         changes
+    }
+
+    /// The integrated discretisation's forces and tangent (see [`ContactFace`]) from the
+    /// multipliers in `state` and the kinematics `sites` of the quadrature points: at each
+    /// quadrature point lambda_q = sum_a N_a lambda_a, the force w_q lambda_q N_j grad Psi on its
+    /// points (and w_q lambda_q dPsi/ds on a force-driven punch) with the curvature tangent
+    /// w_q lambda_q N_j N_k H; for every point of `tangent_points` the penalty tangent
+    /// eps / A_i a_i a_i^T, a_i = sum_q w_q N_i(q) (N_j(q) grad Psi_q, dPsi_q/ds).
+    fn add_integrated(&self, sites: &[Kinematics], dn: &Vector3<f64>, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>) {
+        let face = self.face.as_ref().expect("integrated");
+        let drive = self.drive;
+        for (q, site) in face.quadrature.iter().zip(sites) {
+            let lambda_q: f64 = (0..4).map(|a| q.shape[a] * self.state[q.points[a] as usize].lambda).sum();
+            if lambda_q == 0.0 {
+                continue;
+            }
+            let (_, grad, grad_s, hess_at) = site;
+            let wl = q.weight * lambda_q;
+            for a in 0..4 {
+                let p = &self.points[q.points[a] as usize];
+                for i in 0..3 {
+                    force[p.dofs[i]] += wl * q.shape[a] * grad[i];
+                }
+            }
+            if let Some(f) = &drive {
+                force[f.dof] += wl * grad_s;
+            }
+            let (Some(add), Some(x)) = (add_tangent.as_deref_mut(), hess_at) else { continue };
+            let h = self.surface.hessian(x) * wl;
+            let hn = h * dn;
+            for a in 0..4 {
+                let pa = &self.points[q.points[a] as usize];
+                for b in 0..4 {
+                    let pb = &self.points[q.points[b] as usize];
+                    let nn = q.shape[a] * q.shape[b];
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            add(pa.dofs[i], pb.dofs[j], nn * h[(i, j)]);
+                        }
+                    }
+                }
+                if let Some(f) = &drive {
+                    for i in 0..3 {
+                        add(pa.dofs[i], f.dof, -q.shape[a] * hn[i]);
+                        add(f.dof, pa.dofs[i], -q.shape[a] * hn[i]);
+                    }
+                }
+            }
+            if let Some(f) = &drive {
+                add(f.dof, f.dof, dn.dot(&hn));
+            }
+        }
+        let Some(add) = add_tangent else { return };
+        let mut a_i: Vec<Vector3<f64>> = Vec::new();
+        for (i, _) in self.tangent_points.iter().enumerate().filter(|(_, t)| **t) {
+            let patch = face.patch(i);
+            a_i.clear();
+            a_i.resize(patch.len(), Vector3::zeros());
+            let mut a_s = 0.0;
+            for &(qk, ai) in face.of_point(i) {
+                let q = &face.quadrature[qk as usize];
+                let (_, grad, grad_s, _) = &sites[qk as usize];
+                let wi = q.weight * q.shape[ai as usize];
+                for b in 0..4 {
+                    let j = patch.binary_search(&q.points[b]).expect("a cell's points are in the patch");
+                    a_i[j] += grad * (wi * q.shape[b]);
+                }
+                a_s += wi * grad_s;
+            }
+            let c = self.eps_reg / face.area[i];
+            for (j, aj) in a_i.iter().enumerate() {
+                let pj = &self.points[patch[j] as usize];
+                for (k, ak) in a_i.iter().enumerate() {
+                    let pk = &self.points[patch[k] as usize];
+                    for r in 0..3 {
+                        for cc in 0..3 {
+                            add(pj.dofs[r], pk.dofs[cc], c * aj[r] * ak[cc]);
+                        }
+                    }
+                }
+                if let Some(f) = &drive {
+                    for r in 0..3 {
+                        add(pj.dofs[r], f.dof, c * aj[r] * a_s);
+                        add(f.dof, pj.dofs[r], c * aj[r] * a_s);
+                    }
+                }
+            }
+            if let Some(f) = &drive {
+                add(f.dof, f.dof, c * a_s * a_s);
+            }
+        }
     }
 
     /// The paper's active-set update (eqs. 4.14b, 4.15a) after Newton converged on a fixed set: add
@@ -672,9 +845,30 @@ impl ContactPair {
         r
     }
 
-    /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point.
+    /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point. With the
+    /// integrated discretisation: the contact force on the point along its mean normal per unit
+    /// area, -f_j . n_j / A_j (f_j = int N_j lambda_h grad Psi dA), the nodal value of a field
+    /// whose integral sum_j A_j q_j is the punch's normal force.
     pub fn pressures(&self) -> Vec<f64> {
-        self.state.iter().map(|s| -s.lambda * Vector3::from(s.grad).norm()).collect()
+        let Some(face) = &self.face else {
+            return self.state.iter().map(|s| -s.lambda * Vector3::from(s.grad).norm()).collect();
+        };
+        let mut f = vec![Vector3::zeros(); self.points.len()];
+        for (q, site) in face.quadrature.iter().zip(&self.site_scratch) {
+            let lambda_q: f64 = (0..4).map(|a| q.shape[a] * self.state[q.points[a] as usize].lambda).sum();
+            for a in 0..4 {
+                f[q.points[a] as usize] += site.1 * (q.weight * lambda_q * q.shape[a]);
+            }
+        }
+        f.iter()
+            .zip(&self.state)
+            .zip(&face.area)
+            .map(|((f, s), a)| {
+                let g = Vector3::from(s.grad);
+                let n = g.norm();
+                if n > 0.0 { -f.dot(&g) / (n * a) } else { 0.0 }
+            })
+            .collect()
     }
 }
 
@@ -717,226 +911,4 @@ fn record_flip(flips: &mut u32, frozen: &mut bool, max_flips: u32) {
 }
 
 #[cfg(test)]
-mod motion_tests {
-    use super::PunchMotion;
-
-    #[test]
-    fn a_path_interpolates_holds_and_starts_at_zero() {
-        let p = PunchMotion::path(&[(0.5, [0.0, 0.0, -1.0]), (1.0, [2.0, 0.0, -1.0])]).unwrap();
-        assert_eq!(p.displacement(0.0), [0.0, 0.0, 0.0]);
-        assert_eq!(p.displacement(0.25), [0.0, 0.0, -0.5]);
-        assert_eq!(p.displacement(0.5), [0.0, 0.0, -1.0]);
-        assert_eq!(p.displacement(0.75), [1.0, 0.0, -1.0]);
-        assert_eq!(p.displacement(1.0), [2.0, 0.0, -1.0]);
-        // held beyond the last row, zero below 0
-        assert_eq!(p.displacement(3.0), [2.0, 0.0, -1.0]);
-        assert_eq!(p.displacement(-1.0), [0.0, 0.0, 0.0]);
-        assert_eq!(p.approach(), [0.0, 0.0, -1.0]);
-        assert!(!p.is_zero());
-        // a path equal to a linear motion gives the same displacements
-        let lin = PunchMotion::Linear([0.1, 0.2, -0.3]);
-        let path = PunchMotion::path(&[(1.0, [0.1, 0.2, -0.3])]).unwrap();
-        for t in [0.0, 0.125, 0.5, 0.9, 1.0] {
-            assert_eq!(lin.displacement(t), path.displacement(t), "t = {t}");
-        }
-        assert_eq!(path.approach(), lin.approach());
-    }
-
-    #[test]
-    fn bad_paths_are_refused_with_the_row() {
-        let e = |rows: &[(f64, [f64; 3])]| PunchMotion::path(rows).unwrap_err();
-        assert!(e(&[]).contains("at least one row"));
-        assert!(e(&[(0.5, [0.0; 3]), (0.5, [1.0; 3])]).contains("row 1: the load factors must increase strictly"));
-        assert!(e(&[(-0.5, [0.0; 3])]).contains("row 0"));
-        assert!(e(&[(0.0, [1.0, 0.0, 0.0])]).contains("at t = 0 the displacement must be [0, 0, 0]"));
-        assert!(e(&[(1.0, [f64::NAN, 0.0, 0.0])]).contains("finite"));
-        assert!(PunchMotion::path(&[(0.0, [0.0; 3]), (1.0, [0.0, 0.0, -1.0])]).is_ok());
-    }
-}
-
-#[cfg(test)]
-mod entry_tests {
-    //! The damped growth of the active set: which penetrating points enter in an evaluation with
-    //! a tangent, and that the held-back ones still count as changes until they are in.
-    use super::*;
-    use crate::surface::ContactSurface;
-
-    /// The punch's underside is the plane x3 = 0 (Psi = -x3: a point above it, x3 > 0, penetrates).
-    struct Plane;
-    impl ContactSurface for Plane {
-        fn psi(&self, x: &Vector3<f64>) -> f64 {
-            -x[2]
-        }
-        fn gradient(&self, _x: &Vector3<f64>) -> Vector3<f64> {
-            Vector3::new(0.0, 0.0, -1.0)
-        }
-    }
-
-    /// Four points at x3 = 0 below the plane (touching), each with its own dofs.
-    fn pair(entry_fraction: f64) -> ContactPair {
-        let points = (0..4).map(|k| ContactPoint { node: k, x_ref: [k as f64, 0.0, -1e-3], dofs: [3 * k, 3 * k + 1, 3 * k + 2], weight: 1.0 }).collect();
-        let mut pair = ContactPair::new("plane", Arc::new(Plane), points, 10.0, ContactKinematics::Exact);
-        pair.entry_fraction = entry_fraction;
-        pair
-    }
-
-    /// Evaluate with a tangent at the points' upward displacements `w` (x3 = -1e-3 + w);
-    /// returns the changes and the active flags.
-    fn evaluate(pair: &mut ContactPair, w: [f64; 4]) -> (usize, Vec<bool>) {
-        let mut u = vec![0.0; 12];
-        for k in 0..4 {
-            u[3 * k + 2] = w[k];
-        }
-        let mut force = vec![0.0; 12];
-        let mut add = |_: usize, _: usize, _: f64| {};
-        let changes = pair.evaluate(&u, 0.0, &mut force, Some(&mut add));
-        (changes, pair.state.iter().map(|s| s.active).collect())
-    }
-
-    #[test]
-    fn only_the_deepest_half_of_the_new_penetrations_enters() {
-        let mut p = pair(0.5);
-        // first evaluation: the last point touches (Psi = 0), the others are clear
-        assert_eq!(evaluate(&mut p, [0.0, 0.0, 0.0, 1e-3]), (1, vec![false, false, false, true]));
-        // penetrations 1, 0.6, 0.4 (x3 = w - 1e-3): the deepest is 0.999, half of it 0.4995;
-        // 0.599 enters, 0.399 is held back but counts as a change
-        let w = [1.0, 0.6, 0.4, 1e-3];
-        let (changes, active) = evaluate(&mut p, w);
-        assert_eq!(active, vec![true, true, false, true]);
-        assert_eq!(changes, 3, "two points entered, one is held back");
-        // the held-back point gets no force
-        assert_eq!(p.state[2].lambda, 0.0);
-        assert!(p.state[0].lambda < 0.0 && p.state[1].lambda < 0.0);
-        // next time it is the deepest of the inactive points: it enters, and then nothing changes
-        let (changes, active) = evaluate(&mut p, w);
-        assert_eq!((changes, active), (1, vec![true, true, true, true]));
-        assert_eq!(evaluate(&mut p, w).0, 0);
-    }
-
-    #[test]
-    fn from_an_empty_set_only_the_deepest_penetrations_enter() {
-        // the very first evaluation already overlaps: only the deepest trial (-9.99) enters:
-        // -5.99 and -3.99 are held back
-        let mut p = pair(0.5);
-        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]);
-        assert_eq!(active, vec![true, false, false, false]);
-        assert_eq!(changes, 3, "one point entered, two are held back");
-        assert_eq!(p.state[1].lambda, 0.0);
-        // then the set grows by the damped rule (0.599 and 0.399 against half of 0.599: both)
-        assert_eq!(evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]), (2, vec![true, true, true, false]));
-        // every point released, then two equally deep penetrations: both enter, the shallower
-        // (-2.99 against -4.99) is held back
-        let mut p = pair(0.5);
-        assert_eq!(evaluate(&mut p, [0.0; 4]), (0, vec![false; 4]));
-        let (changes, active) = evaluate(&mut p, [0.5, 0.5, 0.3, 0.0]);
-        assert_eq!((changes, active), (3, vec![true, true, false, false]));
-        // a residual-only evaluation (line-search trial) still sees every penetration
-        let mut p = pair(0.5);
-        let mut u = vec![0.0; 12];
-        u[2] = 1.0;
-        u[5] = 0.6;
-        let mut force = vec![0.0; 12];
-        assert_eq!(p.evaluate(&u, 0.0, &mut force, None), 0, "the first evaluation records its set");
-        assert!(force[2] != 0.0 && force[5] != 0.0);
-    }
-
-    #[test]
-    fn a_lone_point_swinging_in_and_out_is_frozen_after_lone_max_flips_changes() {
-        // nothing penetrates, then point 0 alone: in, out, in (three changes with at most one
-        // point active): frozen, its next swing is no change
-        let mut p = pair(0.5);
-        assert_eq!(evaluate(&mut p, [0.0; 4]).0, 0);
-        let (inside, outside) = ([1.0, 0.0, 0.0, 0.0], [0.0; 4]);
-        for (k, w) in [inside, outside, inside].into_iter().enumerate() {
-            assert_eq!(evaluate(&mut p, w).0, 1, "change {k}");
-        }
-        assert_eq!(LONE_MAX_FLIPS, 3);
-        assert!(p.frozen[0] && !p.frozen[1]);
-        assert_eq!(evaluate(&mut p, outside), (0, vec![false; 4]), "a frozen point follows Psi without counting");
-        // the same swings next to two active points: not lone, counted up to max_flips (10)
-        let mut p = pair(0.5);
-        let (inside, outside) = ([1.0, 0.0, 1.0, 1.0], [0.0, 0.0, 1.0, 1.0]);
-        assert_eq!(evaluate(&mut p, outside).1, vec![false, false, true, true]);
-        for k in 0..9 {
-            assert_eq!(evaluate(&mut p, if k % 2 == 0 { inside } else { outside }).0, 1, "change {k}");
-        }
-        assert!(!p.frozen[0]);
-        assert_eq!(evaluate(&mut p, outside).0, 1);
-        assert!(p.frozen[0], "frozen at the tenth change");
-    }
-
-    #[test]
-    fn the_first_iteration_of_a_load_step_takes_only_the_deepest_tenth() {
-        let mut p = pair(0.5);
-        evaluate(&mut p, [0.0, 0.0, 0.0, 1e-3]);
-        p.start_step(false);
-        // trials -9.99, -5.99, -3.99 against 0.9 * -9.99: only the first enters
-        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 1e-3]);
-        assert_eq!((changes, active), (3, vec![true, false, false, true]));
-        // the next iteration uses entry_fraction (half of -5.99): both enter
-        assert_eq!(evaluate(&mut p, [1.0, 0.6, 0.4, 1e-3]), (2, vec![true; 4]));
-    }
-
-    #[test]
-    fn a_predicted_step_takes_every_penetrating_point_at_once_and_the_next_step_damps_again() {
-        // from the coarse mesh's solution: no damping, not even at the first evaluation (which
-        // would take the deepest point only and count the others as changes): every
-        // penetrating point is in the set it records
-        let mut p = pair(0.5);
-        p.start_step(true);
-        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]);
-        assert_eq!((changes, active), (0, vec![true, true, true, false]));
-        // later evaluations of the step too: a point that starts penetrating enters at once
-        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 1.0]);
-        assert_eq!((changes, active), (1, vec![true; 4]));
-        // a step from the secant predictor damps as before: of the new penetrations (trials
-        // -9.99, -5.99, -3.99 against 0.9 * -9.99) only the deepest enters
-        let mut p = pair(0.5);
-        p.start_step(true);
-        assert_eq!(evaluate(&mut p, [1.0, 0.0, 0.0, 0.0]), (0, vec![true, false, false, false]));
-        p.start_step(false);
-        let (changes, active) = evaluate(&mut p, [1.0, 1.0, 0.6, 0.4]);
-        assert_eq!((changes, active), (3, vec![true, true, false, false]));
-    }
-
-    #[test]
-    fn right_after_an_augmented_lagrangian_update_no_point_is_released() {
-        // points 0 and 1 in contact (lambda -9.99 each), an update (lambda_bar <- lambda), then
-        // point 1 lifts off by 2 (trial -9.99 + 10 * 2.001 > 0): the next evaluation with a
-        // tangent keeps it, the one after releases it
-        let mut p = pair(0.5);
-        assert_eq!(evaluate(&mut p, [1.0, 1.0, 0.0, 0.0]).1, vec![true, true, false, false]);
-        p.augment();
-        let lifted = [1.0, -2.0, 0.0, 0.0];
-        let (changes, active) = evaluate(&mut p, lifted);
-        assert_eq!((changes, active.clone()), (0, vec![true, true, false, false]), "held right after the update");
-        let (changes, active) = evaluate(&mut p, lifted);
-        assert_eq!((changes, active), (1, vec![true, false, false, false]), "released at the next evaluation");
-        // without an update in between it is released at once
-        let mut q = pair(0.5);
-        evaluate(&mut q, [1.0, 1.0, 0.0, 0.0]);
-        assert_eq!(evaluate(&mut q, lifted), (1, vec![true, false, false, false]));
-    }
-
-    #[test]
-    fn with_entry_fraction_zero_every_penetrating_point_enters_at_once() {
-        let mut p = pair(0.0);
-        evaluate(&mut p, [0.0; 4]);
-        let (changes, active) = evaluate(&mut p, [1.0, 0.6, 0.4, 0.0]);
-        assert_eq!((changes, active), (3, vec![true, true, true, false]));
-    }
-
-    #[test]
-    fn a_residual_only_evaluation_reports_the_true_changes_and_holds_nothing_back() {
-        let mut p = pair(0.5);
-        evaluate(&mut p, [0.0; 4]);
-        let mut u = vec![0.0; 12];
-        u[2] = 1.0;
-        u[8] = 0.4;
-        let mut force = vec![0.0; 12];
-        // a line-search trial: the force of every penetrating point, nothing recorded
-        assert_eq!(p.evaluate(&u, 0.0, &mut force, None), 2);
-        assert!(force[8] != 0.0, "the shallow penetration acts in a residual-only evaluation");
-        assert_eq!(p.last_active, vec![false; 4]);
-    }
-}
+mod entry_tests;
