@@ -135,7 +135,7 @@ fn a_probe_across_the_full_gmsh_model_is_symmetric_about_the_centre() {
     let (_, _, s) = stamp_run(&problem, &out);
     let last = s["steps"].as_array().unwrap().last().unwrap()["step"].as_u64().unwrap();
     let (hd, rows) = read_csv(&out.join(format!("probe_diagonal_{last:04}.csv")));
-    assert_eq!(&hd[..], ["distance", "x1", "x2", "u1", "u2", "u3", "sphere_q_n"]);
+    assert_eq!(&hd[..], ["distance", "x1", "x2", "u1", "u2", "u3", "sphere_pressure", "sphere_integral", "sphere_line_load"]);
     assert_eq!(rows.len(), 101, "every point lies in the plate");
     let len = 34.0f64.hypot(14.0);
     let q_max = rows.iter().map(|r| r[6]).fold(0.0, f64::max);
@@ -153,6 +153,16 @@ fn a_probe_across_the_full_gmsh_model_is_symmetric_about_the_centre() {
         assert!((a[3] + b[3]).abs() <= 1e-6 * rows[50][5].abs(), "u1 at s = {}: {} against {}", a[0], a[3], b[3]);
     }
     eprintln!("largest asymmetry of q_n: {worst:e} of max q_n");
+    // the integral column is the trapezoidal integral of the pressure along the line, from 0
+    let mut integral = 0.0;
+    for i in 0..rows.len() {
+        if i > 0 {
+            integral += 0.5 * (rows[i][0] - rows[i - 1][0]) * (rows[i][6] + rows[i - 1][6]);
+        }
+        assert!((rows[i][7] - integral).abs() <= 1e-6 * integral.max(q_max), "integral at s = {}: {} against {integral}", rows[i][0], rows[i][7]);
+    }
+    // the band's integral grows along the line, and the whole line crosses the zone in both
+    assert!(rows.windows(2).all(|w| w[1][8] >= w[0][8]) && rows[100][8] > 0.0 && rows[100][7] > 0.0);
 }
 
 #[test]

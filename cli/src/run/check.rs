@@ -14,7 +14,7 @@
 //!
 //! Warnings (the solve goes on): a punch whose motion or force moves it away from its contact face;
 //! a punch on the side of the plate away from its contact face; after a run, a punch that never
-//! touched the plate ([`never_touched`]).
+//! touched the plate or touched it on a zone narrower than the cells ([`after_the_run`]).
 
 use super::build::Setup;
 use super::mesh::MeshData;
@@ -314,9 +314,10 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
     out
 }
 
-/// After a run: the punches that had no node in contact at any step recorded in `summary`
-/// (summary.json), one warning each.
-pub fn never_touched(p: &Problem, summary: &Path) -> Vec<String> {
+/// After a run, from `summary` (summary.json), one warning each: a punch that had no node in
+/// contact at any recorded step, and a punch whose loaded zone at the last step is narrower than
+/// the cells (see [`super::output::narrower_than_cells`]).
+pub fn after_the_run(p: &Problem, summary: &Path) -> Vec<String> {
     let Ok(text) = std::fs::read_to_string(summary) else { return Vec::new() };
     let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
     let Some(steps) = json["steps"].as_array() else { return Vec::new() };
@@ -328,6 +329,16 @@ pub fn never_touched(p: &Problem, summary: &Path) -> Vec<String> {
     for i in 0..p.spec.punch.len() {
         let name = p.punch_name(i);
         let counts: Vec<u64> = converged.iter().filter_map(|s| s["punches"][&name]["active_nodes"].as_u64()).collect();
+        if let Some(last) = converged.last() {
+            if last["punches"][&name]["zone_narrower_than_cells"] == serde_json::Value::Bool(true) {
+                out.push(format!(
+                    "{}: punch[{i}] ('{}') touches the plate on a zone narrower than the cells (a line or ring of nodes, none with all its neighbours in contact) at the last step: its peak pressure depends on the mesh and will not converge as the cells shrink; the force does, and so does the load per unit length that a probe across the zone reads (column {}_line_load)",
+                    file(p),
+                    quote(&name),
+                    name
+                ));
+            }
+        }
         if counts.len() == converged.len() && counts.iter().all(|&c| c == 0) {
             out.push(format!(
                 "{}: punch[{i}] ('{}') never touched the plate: no node was in contact at any of the {} recorded steps; check its position, motion and face",

@@ -52,7 +52,7 @@ pub fn run(problem: &Path, out: Option<&Path>, quiet: bool) -> stamp::Result<Run
     }
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
     let outcome = solve::solve_and_write(&p, setup, &out_dir, &solve::SolveOptions { quiet, ..Default::default() });
-    for w in check::never_touched(&p, &out_dir.join("summary.json")) {
+    for w in check::after_the_run(&p, &out_dir.join("summary.json")) {
         eprintln!("warning: {w}");
     }
     outcome

@@ -80,6 +80,31 @@ pub struct PunchOut {
     pub max_penetration: f64,
     pub max_pressure: f64,
     pub eps_reg: f64,
+    /// The loaded zone is narrower than the cells: at least three nodes are loaded and none of
+    /// them has all its cells' nodes loaded (a line or a ring of nodes): the peak pressure then
+    /// depends on the mesh (see [`narrower_than_cells`]).
+    pub zone_narrower_than_cells: bool,
+}
+
+/// Whether the loaded nodes (`loaded[node]`) form a zone narrower than the cells: at least three
+/// of them and none whose cells' nodes are all loaded. Such a zone (a cylinder across a plate, the
+/// rim of a conforming contact) is a line load at the scale of the mesh: its nodal pressures take
+/// the load in turn and their peak does not converge as the cells shrink, while the force and the
+/// load per unit length (`<punch>_line_load` of a probe across it) do.
+pub fn narrower_than_cells(cells: &[[usize; 4]], loaded: &[bool]) -> bool {
+    let count = loaded.iter().filter(|l| **l).count();
+    if count < 3 {
+        return false;
+    }
+    let mut open = vec![false; loaded.len()];
+    for c in cells {
+        if !c.iter().all(|&n| loaded[n]) {
+            for &n in c {
+                open[n] = true;
+            }
+        }
+    }
+    !loaded.iter().zip(&open).any(|(l, o)| *l && !*o)
 }
 
 /// One converged step of summary.json.
@@ -194,6 +219,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         let mut p_loaded = Vec::new();
         let mut rows = Vec::with_capacity(pair.points.len());
         let mut n_active = 0;
+        let mut loaded_here = vec![false; n];
         for (k, (pt, st)) in pair.points.iter().zip(&pair.state).enumerate() {
             let node = pt.node;
             candidate[node] = true;
@@ -209,6 +235,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
             }
             if lam_max > 0.0 && st.lambda.abs() > cx.threshold * lam_max {
                 loaded[node] = 1.0;
+                loaded_here[node] = true;
                 p_loaded.push(pt.x_ref);
             }
             let d = face_disp(u, node, info.face);
@@ -253,6 +280,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
                 max_penetration: pen,
                 max_pressure: q.iter().cloned().fold(0.0, f64::max),
                 eps_reg: pair.eps_reg,
+                zone_narrower_than_cells: narrower_than_cells(&cx.mesh.mesh.cells, &loaded_here),
             },
         );
         loaded_pts.extend(p_loaded);

@@ -14,9 +14,17 @@
 //! the line are added to the equally spaced points (so curves pass through the nodal values, drawn
 //! as markers); points outside the mesh are left out of the CSV and the plot. Per written step `probe_<name>_<step>.csv` has the columns
 //! `distance` (from `from`), `x1`, `x2` (reference), `u1`, `u2`, `u3` (mid-surface displacement)
-//! and `<punch>_q_n` for each punch; `probe_<name>.png/.svg` draws the contact pressure (summed over
-//! the punches) of up to [`MAX_CURVES`] written steps spread evenly over the load path, labelled by
-//! the first punch's force (force driven) or travel; markers show the points that are nodes.
+//! and, for each punch, `<punch>_pressure` (the contact pressure, the paper's q_n),
+//! `<punch>_integral` (the integral of the pressure along the line from `from` to the point, by
+//! the trapezoidal rule over the points) and `<punch>_line_load` (the same integral of the
+//! pressure averaged across a band of [`BAND_CELLS`] cell sizes centred on the line). Across a
+//! roller the last row's integral is the load per unit length; where the contact is a line
+//! narrower than the cells, the nodes next to the line carry it in turn and the integral along
+//! one line of an unstructured mesh varies from line to line, while the band's converges (the
+//! force in the band divided by its width). `probe_<name>.png/.svg` draws the contact pressure
+//! (summed over the punches) of up to [`MAX_CURVES`] written steps spread evenly over the load
+//! path, labelled by the first punch's force (force driven) or travel; markers show the points
+//! that are nodes; its title gives the last step's integrals.
 //!
 //! With no probe, a punch and `plot = true`, a default probe named `<punch>` crosses the whole mesh
 //! along x1 (or along `plot_axis` when the file gives it; "arc" means x1) through the first contact
@@ -41,6 +49,10 @@ use toml::Spanned;
 pub const MAX_CURVES: usize = 8;
 /// Default number of points of a probe.
 pub const DEFAULT_POINTS: usize = 200;
+/// The width of the band of `<punch>_line_load`, in cell sizes (the square root of the mean cell
+/// area), and the number of lines across it that sample it.
+pub const BAND_CELLS: f64 = 8.0;
+const BAND_LINES: usize = 17;
 
 /// One `[[output.probe]]` table.
 #[derive(Debug, Clone, Deserialize)]
@@ -178,6 +190,9 @@ pub struct Sample {
     pub weights: [f64; 4],
     /// Whether the point is a node (a shape function is 1 to round-off).
     pub at_node: bool,
+    /// The points across the band at this distance that lie in the mesh (nodes and shape
+    /// functions), see [`BAND_CELLS`].
+    pub band: Vec<([usize; 4], [f64; 4])>,
 }
 
 /// The points of one probe line that lie in the mesh: the equally spaced points and the mesh nodes
@@ -199,11 +214,19 @@ impl ProbeLine {
         let len = (to[0] - from[0]).hypot(to[1] - from[1]);
         let dir = [(to[0] - from[0]) / len, (to[1] - from[1]) / len];
         let tol = 1e-9 * len;
+        let width = BAND_CELLS * (mesh.nodal_areas().iter().sum::<f64>() / mesh.num_cells().max(1) as f64).sqrt();
         let mut samples: Vec<Sample> = Vec::new();
         let mut add = |distance: f64, x: [f64; 2]| {
             if let Some((c, xi)) = locator.locate(x) {
                 let (w, _) = bilinear(xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0));
-                samples.push(Sample { distance, x, nodes: mesh.cells[c], weights: w, at_node: w.iter().any(|&v| v > 1.0 - 1e-9) });
+                let band = (0..BAND_LINES)
+                    .filter_map(|k| {
+                        let t = width * (k as f64 / (BAND_LINES - 1) as f64 - 0.5);
+                        let (c, xi) = locator.locate([x[0] + t * dir[1], x[1] - t * dir[0]])?;
+                        Some((mesh.cells[c], bilinear(xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0)).0))
+                    })
+                    .collect();
+                samples.push(Sample { distance, x, nodes: mesh.cells[c], weights: w, at_node: w.iter().any(|&v| v > 1.0 - 1e-9), band });
             }
         };
         let mut wanted: Vec<(f64, [f64; 2])> = (0..points)
@@ -244,6 +267,37 @@ impl ProbeLine {
     pub fn interpolate(&self, f: impl Fn(usize) -> f64) -> Vec<f64> {
         self.samples.iter().map(|s| (0..4).map(|a| s.weights[a] * f(s.nodes[a])).sum()).collect()
     }
+
+    /// The mean of the nodal field `f` across the band at every sample (see [`BAND_CELLS`]; over
+    /// the band's points in the mesh).
+    pub fn band_mean(&self, f: impl Fn(usize) -> f64) -> Vec<f64> {
+        self.samples
+            .iter()
+            .map(|s| {
+                let sum: f64 = s.band.iter().map(|(nodes, w)| (0..4).map(|a| w[a] * f(nodes[a])).sum::<f64>()).sum();
+                sum / s.band.len().max(1) as f64
+            })
+            .collect()
+    }
+
+    /// The running integral of `values` (one per sample) along the line, by the trapezoidal rule;
+    /// a gap in the samples (a hole of the mesh) adds nothing.
+    pub fn running_integral(&self, values: &[f64]) -> Vec<f64> {
+        let spacing = (self.to[0] - self.from[0]).hypot(self.to[1] - self.from[1]) / (self.points - 1).max(1) as f64;
+        let mut out = Vec::with_capacity(values.len());
+        let mut sum = 0.0;
+        for k in 0..values.len() {
+            if k > 0 {
+                let dd = self.samples[k].distance - self.samples[k - 1].distance;
+                // consecutive samples are at most one spacing apart; farther: the line left the mesh
+                if dd <= spacing * (1.0 + 1e-6) {
+                    sum += 0.5 * dd * (values[k] + values[k - 1]);
+                }
+            }
+            out.push(sum);
+        }
+        out
+    }
 }
 
 /// Nodal contact pressure q_n of one punch (0 at nodes that are not its candidates).
@@ -260,6 +314,9 @@ struct Curve {
     row: HistoryRow,
     points: Vec<(f64, f64)>,
     markers: Vec<(f64, f64)>,
+    /// The integral of the pressure along the line, and across the band (all punches).
+    integral: f64,
+    line_load: f64,
 }
 
 /// The default probe, decided at the first written step.
@@ -358,9 +415,11 @@ impl<'a> Probes<'a> {
         for (line, curves) in self.lines.iter().zip(&mut self.curves) {
             let disp: Vec<Vec<f64>> = (0..3).map(|i| line.interpolate(|n| layout.mid_displacement(u, n)[i])).collect();
             let qs: Vec<Vec<f64>> = q.iter().map(|qk| line.interpolate(|n| qk[n])).collect();
+            let integrals: Vec<Vec<f64>> = qs.iter().map(|v| line.running_integral(v)).collect();
+            let loads: Vec<Vec<f64>> = q.iter().map(|qk| line.running_integral(&line.band_mean(|n| qk[n]))).collect();
             let mut csv = String::from("distance,x1,x2,u1,u2,u3");
             for n in punch_names {
-                csv.push_str(&format!(",{n}_q_n"));
+                csv.push_str(&format!(",{n}_pressure,{n}_integral,{n}_line_load"));
             }
             csv.push('\n');
             let mut points = Vec::with_capacity(line.samples.len());
@@ -368,8 +427,8 @@ impl<'a> Probes<'a> {
             for (k, s) in line.samples.iter().enumerate() {
                 csv.push_str(&format!("{:e},{:e},{:e},{:e},{:e},{:e}", s.distance, s.x[0], s.x[1], disp[0][k], disp[1][k], disp[2][k]));
                 let mut total = 0.0;
-                for qk in &qs {
-                    csv.push_str(&format!(",{:e}", qk[k]));
+                for ((qk, ik), lk) in qs.iter().zip(&integrals).zip(&loads) {
+                    csv.push_str(&format!(",{:e},{:e},{:e}", qk[k], ik[k], lk[k]));
                     total += qk[k];
                 }
                 csv.push('\n');
@@ -381,7 +440,8 @@ impl<'a> Probes<'a> {
             let path = dir.join(format!("probe_{}_{step:04}.csv", line.name));
             write_string_atomically(&path, &csv)?;
             files.push(path);
-            curves.push(Curve { row: row.clone(), points, markers });
+            let last = |v: &Vec<Vec<f64>>| v.iter().map(|x| x.last().copied().unwrap_or(0.0)).sum::<f64>();
+            curves.push(Curve { row: row.clone(), points, markers, integral: last(&integrals), line_load: last(&loads) });
         }
         Ok(files)
     }
@@ -402,7 +462,14 @@ impl<'a> Probes<'a> {
                 })
                 .collect();
             let [a, b] = [line.from, line.to].map(|p| format!("({}, {})", sig4(p[0]), sig4(p[1])));
-            let title = format!("contact pressure along probe '{}' from {a} to {b}", line.name);
+            let end = curves.last().expect("not empty");
+            let title = format!(
+                "contact pressure along probe '{}' from {a} to {b}; at the last step its integral is {} ({} across a band of {} cells)",
+                line.name,
+                sig4(end.integral),
+                sig4(end.line_load),
+                BAND_CELLS
+            );
             let x = Units::label("distance along the line", &units.length);
             let y = Units::label("contact pressure q_n", &units.pressure);
             let plot = Plot { title: &title, x_label: &x, y_label: &y, series: &series };
@@ -500,6 +567,35 @@ mod tests {
             assert!((v - f(s.x)).abs() < 1e-10, "{:?}: {v} against {}", s.x, f(s.x));
         }
         assert!(line.samples[0].at_node && line.samples[40].at_node);
+    }
+
+    #[test]
+    fn the_band_mean_of_an_affine_field_is_its_value_and_integrals_are_exact_for_it() {
+        // a distorted 8 x 8 mesh on [0, 8]^2, a line across its middle: the band (8 cells wide)
+        // stays inside, so its mean of an affine field is the field on the line
+        let mut mesh = QuadMesh::rectangle(0.0, 8.0, 0.0, 8.0, 8, 8).unwrap();
+        for (k, c) in mesh.coords.iter_mut().enumerate() {
+            if c[0] > 0.0 && c[0] < 8.0 && c[1] > 0.0 && c[1] < 8.0 {
+                c[0] += 0.2 * ((k as f64) * 1.3).sin();
+                c[1] += 0.2 * ((k as f64) * 0.7).cos();
+            }
+        }
+        let loc = CellLocator::new(&mesh);
+        let line = ProbeLine::new("l", [1.0, 4.0], [7.0, 4.0], 61, &mesh, &loc);
+        let f = |x: [f64; 2]| 2.0 + 0.5 * x[0] + 3.0 * x[1];
+        let on_line = line.interpolate(|n| f(mesh.coords[n]));
+        let band = line.band_mean(|n| f(mesh.coords[n]));
+        for ((s, a), b) in line.samples.iter().zip(&on_line).zip(&band) {
+            assert_eq!(s.band.len(), BAND_LINES, "the whole band lies in the mesh");
+            assert!((a - b).abs() < 1e-10, "at {:?}: {a} on the line, {b} across the band", s.x);
+        }
+        // int_1^7 (2 + 0.5 x + 12) dx = 14 * 6 + 0.25 * (49 - 1) = 96, exact for a linear integrand
+        let integral = line.running_integral(&on_line);
+        assert!((integral.last().unwrap() - 96.0).abs() < 1e-9, "{}", integral.last().unwrap());
+        assert_eq!(integral[0], 0.0);
+        // a band that leaves the mesh averages over its points inside
+        let edge = ProbeLine::new("e", [1.0, 0.5], [7.0, 0.5], 7, &mesh, &loc);
+        assert!(edge.samples.iter().all(|s| s.band.len() < BAND_LINES && !s.band.is_empty()));
     }
 
     #[test]

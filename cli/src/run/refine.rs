@@ -114,7 +114,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     let mut previous_mesh = setup.mesh.mesh.clone();
     let opts = SolveOptions { quiet, no_table: true, targets: None, refinement: Some(running), caller_finishes: true, record_states: true, previous: None };
     let coarse = solve_and_write(&p, setup, &out_dir, &opts);
-    for w in super::check::never_touched(&p, &out_dir.join("summary.json")) {
+    for w in super::check::after_the_run(&p, &out_dir.join("summary.json")) {
         eprintln!("warning: {w}");
     }
     let mut coarse = match coarse {
