@@ -200,6 +200,9 @@ pub struct ContactPair {
     /// A point is coupled once its gap (Psi / |grad Psi|) is at most this length (set by the
     /// caller: the plate's thickness, say); default 0: only points in contact.
     pub coupling_reach: f64,
+    /// The points that entered the active set at the last evaluation with a tangent: the next
+    /// such evaluation does not release them (see [`ContactPair::evaluate`]).
+    entered: Vec<bool>,
 }
 
 /// Psi, its gradient with respect to the displacement of the point (or quadrature point), its
@@ -324,6 +327,7 @@ impl ContactPair {
             coupling_version: 0,
             needs_coupling: false,
             coupling_reach: 0.0,
+            entered: vec![false; n],
         }
     }
 
@@ -402,6 +406,7 @@ impl ContactPair {
     /// an outside prediction of its answer (see `predicted_step`).
     pub fn start_step(&mut self, predicted: bool) {
         self.predicted_step = predicted;
+        self.entered.fill(false);
         self.flips.fill(0);
         self.frozen.fill(false);
         self.step_start = true;
@@ -458,7 +463,9 @@ impl ContactPair {
         // "near the kink" is 1 % of the largest multiplier now, or of the largest in this step
         // when every point is momentarily inactive (a lone point swinging in and out)
         let current = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
-        self.lambda_scale = self.lambda_scale.max(current);
+        // (the scale of the last converged state, see start_step: an iterate far from the
+        // solution, a lone first touch under a whole step of travel, can carry multipliers many
+        // times the converged ones, and a band that wide would hold a point off the punch)
         let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
         let mut any_tangent = false;
         // Psi, its gradient with respect to the point's displacement and to s, and where the
@@ -553,6 +560,7 @@ impl ContactPair {
         for (k, p) in self.points.iter().enumerate() {
             let (psi, grad, grad_s, hess) = kin[k];
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
+            let was_active = self.last_active[k] && !first;
             // touching points (Psi = 0) belong to the active set
             let wanted = trial <= 0.0;
             if first {
@@ -564,8 +572,16 @@ impl ContactPair {
             let active = if deferred {
                 changes += 1;
                 false
-            } else if with_tangent && self.hold_after_update && self.last_active[k] && !wanted && !self.frozen[k] {
-                // right after an augmented-Lagrangian update: not released yet (hold_after_update)
+            } else if with_tangent && (self.hold_after_update || self.entered[k]) && self.last_active[k] && !wanted && !self.frozen[k] {
+                // right after an augmented-Lagrangian update (hold_after_update), or right after
+                // the point entered: not released yet. A Newton step puts a point that enters onto
+                // the punch's tangent plane at its last position; on a convex punch Psi is positive
+                // there by about d^T H d / 2 (d its step), so the point would be released at once
+                // and the plate, free of its force, spring back into the punch at the next iterate:
+                // a first touch under a whole load step swung in and out until it froze, and the
+                // step was cut back seven times on the README's ball. Kept for one iteration, its
+                // force is the exact lambda_bar + eps Psi (briefly tensile) and the curvature term
+                // lambda H of the tangent brings it back onto the punch.
                 true
             } else if self.hold_active_set {
                 // the paper's trial and error: the set stays fixed while Newton converges on it
@@ -587,6 +603,9 @@ impl ContactPair {
                 }
                 wanted
             };
+            if with_tangent {
+                self.entered[k] = active && !was_active;
+            }
             let lambda = if active { trial } else { 0.0 };
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
             // a point that cycled keeps the active-side tangent near the kink (its force stays exact)
