@@ -203,6 +203,9 @@ pub struct ContactPair {
     /// The points that entered the active set at the last evaluation with a tangent: the next
     /// such evaluation does not release them (see [`ContactPair::evaluate`]).
     entered: Vec<bool>,
+    /// Hold a point that entered for one iteration (default true; false: the plain semi-smooth
+    /// rule, which releases it at once).
+    pub hold_after_entry: bool,
 }
 
 /// Psi, its gradient with respect to the displacement of the point (or quadrature point), its
@@ -328,6 +331,7 @@ impl ContactPair {
             needs_coupling: false,
             coupling_reach: 0.0,
             entered: vec![false; n],
+            hold_after_entry: true,
         }
     }
 
@@ -463,9 +467,7 @@ impl ContactPair {
         // "near the kink" is 1 % of the largest multiplier now, or of the largest in this step
         // when every point is momentarily inactive (a lone point swinging in and out)
         let current = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
-        // (the scale of the last converged state, see start_step: an iterate far from the
-        // solution, a lone first touch under a whole step of travel, can carry multipliers many
-        // times the converged ones, and a band that wide would hold a point off the punch)
+        self.lambda_scale = self.lambda_scale.max(current);
         let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
         let mut any_tangent = false;
         // Psi, its gradient with respect to the point's displacement and to s, and where the
@@ -572,7 +574,7 @@ impl ContactPair {
             let active = if deferred {
                 changes += 1;
                 false
-            } else if with_tangent && (self.hold_after_update || self.entered[k]) && self.last_active[k] && !wanted && !self.frozen[k] {
+            } else if with_tangent && (self.hold_after_update || (self.entered[k] && self.hold_after_entry && !self.hold_active_set && !self.predicted_step)) && self.last_active[k] && !wanted && !self.frozen[k] {
                 // right after an augmented-Lagrangian update (hold_after_update), or right after
                 // the point entered: not released yet. A Newton step puts a point that enters onto
                 // the punch's tangent plane at its last position; on a convex punch Psi is positive
@@ -581,7 +583,12 @@ impl ContactPair {
                 // a first touch under a whole load step swung in and out until it froze, and the
                 // step was cut back seven times on the README's ball. Kept for one iteration, its
                 // force is the exact lambda_bar + eps Psi (briefly tensile) and the curvature term
-                // lambda H of the tangent brings it back onto the punch.
+                // lambda H of the tangent brings it back onto the punch (not in a step started
+                // from a coarse mesh's solution, which has no such overshoot). A point held after entry
+                // counts as a change (no state with a tensile force is converged) but not as a flip.
+                if !self.hold_after_update {
+                    changes += 1;
+                }
                 true
             } else if self.hold_active_set {
                 // the paper's trial and error: the set stays fixed while Newton converges on it
