@@ -31,6 +31,7 @@ pub mod richardson;
 pub mod rigid_modes;
 pub mod solve;
 pub mod table;
+pub mod travel_modes;
 pub mod units;
 
 pub use problem::Problem;
