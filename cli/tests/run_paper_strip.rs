@@ -2,6 +2,8 @@
 //! through the generic problem-file path, and the files it writes.
 
 mod common;
+#[path = "../../tests/common/python.rs"]
+mod python;
 use common::*;
 use serde_json::Value;
 use std::process::Command;
@@ -85,10 +87,8 @@ fn paper_r100_reproduces_table2_last_row() {
         assert!(!name.starts_with('.') || name == stamp_cli::run::out_dir::MANIFEST, "temporary file {name} left");
     }
 
-    // an independent reader: VTK (skipped when python3 has no vtk module)
-    let has_vtk = Command::new("python3").args(["-c", "import vtk"]).output().map(|o| o.status.success()).unwrap_or(false);
-    if !has_vtk {
-        eprintln!("SKIP: python3 -c 'import vtk' failed; the .vtu is not checked with VTK (CI installs it)");
+    // an independent reader: VTK
+    if !python::python_with(&["vtk"], "reading the strip's .vtu back with VTK") {
         return;
     }
     let vtu = out.join(last["vtu"].as_str().unwrap());
