@@ -23,7 +23,7 @@
 //! touched the plate ([`never_touched`]).
 
 use super::build::Setup;
-use super::mesh::MeshData;
+use super::mesh::{where_node, MeshData};
 use super::problem::{LoadFace, LoadKind, Problem};
 use super::punch_start::{first_gap, gap_at, start_gaps, PointGap};
 use super::rigid_modes::{direction_words, join_and, num, RigidModes};
@@ -96,18 +96,6 @@ fn bbox(mesh: &MeshData) -> ([f64; 2], [f64; 2]) {
         }
     }
     (lo, hi)
-}
-
-/// "node at (x1, x2) = (1, 2) (gmsh node 17)"; a node the reader or a refinement added (tag 0)
-/// has no gmsh tag to name.
-pub fn where_node(mesh: &MeshData, node: usize) -> String {
-    let x = mesh.mesh.coords[node];
-    let tag = match mesh.node_tags.as_ref().and_then(|t| t.get(node)) {
-        Some(0) => " (not a gmsh node: added where a cell was cut)".to_string(),
-        Some(t) => format!(" (gmsh node {t})"),
-        None => String::new(),
-    };
-    format!("the node at (x1, x2) = ({}, {}){tag}", num(x[0]), num(x[1]))
 }
 
 fn vec3(v: [f64; 3]) -> String {
