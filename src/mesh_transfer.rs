@@ -16,7 +16,7 @@ use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
 /// Interpolation weights of a fine mesh's nodes in a coarse mesh's cells: fine node j takes
-/// sum_a weights[j][a] * coarse[nodes[j][a]].
+/// `sum_a weights[j][a] * coarse[nodes[j][a]]`.
 #[derive(Debug, Clone)]
 pub struct Prolongation {
     nodes: Vec<[usize; 4]>,

@@ -1,5 +1,8 @@
 //! Writing ParaView files (.vtu, .pvd) and atomic writes.
 
+#[path = "common/python.rs"]
+mod python;
+use python::python_with;
 use stamp::io::atomic::{write_atomically, write_string_atomically};
 use stamp::io::vtk::{write_pvd, write_vtu, Field};
 use stamp::mesh::QuadMesh;
@@ -152,10 +155,7 @@ fn bad_fields_are_refused_naming_the_field_and_keep_the_old_file() {
 
 #[test]
 fn vtu_checked_by_python_vtk() {
-    let available =
-        Command::new("python3").args(["-c", "import vtk"]).output().map(|o| o.status.success()).unwrap_or(false);
-    if !available {
-        println!("NOTE: vtu_checked_by_python_vtk skipped: `python3 -c \"import vtk\"` fails (pip install vtk)");
+    if !python_with(&["vtk"], "reading the .vtu back with VTK") {
         return;
     }
     let dir = scratch("python");
@@ -252,13 +252,12 @@ fn pvd_is_valid_xml_for_python() {
     let code = "import sys, xml.etree.ElementTree as E\n\
                 r = E.parse(sys.argv[1]).getroot()\n\
                 print('|'.join(d.get('timestep') + '=' + d.get('file') for d in r.iter('DataSet')))";
-    match Command::new("python3").args(["-c", code]).arg(&path).output() {
-        Ok(out) if out.status.success() => {
-            let s = String::from_utf8_lossy(&out.stdout);
-            assert_eq!(s.trim(), "0.5=a \"quoted\" & odd.vtu|1=b.vtu");
-        }
-        _ => println!("NOTE: pvd_is_valid_xml_for_python skipped: python3 not available"),
+    if !python_with(&[], "parsing the .pvd with Python's XML parser") {
+        return;
     }
+    let out = Command::new("python3").args(["-c", code]).arg(&path).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "0.5=a \"quoted\" & odd.vtu|1=b.vtu");
 }
 
 #[test]

@@ -151,7 +151,7 @@ fn loaded_zone_grows_monotonically_under_monotone_loading() {
 /// clamped plate's centre node carries no load at t = 0.7 and carries load again at t = 0.8. Inside
 /// the contact zone of a thin plate the pressure is nearly zero (Kirchhoff theory puts the whole
 /// force on the contact edge, del^4 w = 0 under a paraboloid; the paper's strip even lifts off the
-/// cylinder at its centre, b_int > 0, SPEC section 5), so interior nodes sit at the kink
+/// cylinder at its centre, b_int > 0, the paper's section 5), so interior nodes sit at the kink
 /// lambda = min(0, eps Psi) ~ 0 and their membership is not a property of the solution. This is not
 /// an active-set failure; here only the outer radius is required to grow.
 #[test]

@@ -2,6 +2,8 @@
 //! through the generic problem-file path, and the files it writes.
 
 mod common;
+#[path = "../../tests/common/python.rs"]
+mod python;
 use common::*;
 use serde_json::Value;
 use std::process::Command;
@@ -44,7 +46,7 @@ fn paper_r100_reproduces_table2_last_row() {
     let pr = vec3(&last["punches"]["cylinder"]["reaction"]);
     assert_eq!(pr, r);
 
-    // loaded zone on the half plate: [0, 90] in x2 (SPEC 6: one node inside the paper's 92.5)
+    // loaded zone on the half plate: [0, 90] in x2 (one node inside the paper's 92.5: docs/verification.md)
     let zone = &last["loaded_zone"];
     let (lo, hi) = (vec3(&zone["min"]), vec3(&zone["max"]));
     assert!(lo[1].abs() < 1e-9 && (hi[1] - 90.0).abs() < 1e-9, "loaded zone {lo:?} .. {hi:?}");
@@ -85,10 +87,8 @@ fn paper_r100_reproduces_table2_last_row() {
         assert!(!name.starts_with('.') || name == stamp_cli::run::out_dir::MANIFEST, "temporary file {name} left");
     }
 
-    // an independent reader: VTK (skipped when python3 has no vtk module)
-    let has_vtk = Command::new("python3").args(["-c", "import vtk"]).output().map(|o| o.status.success()).unwrap_or(false);
-    if !has_vtk {
-        eprintln!("SKIP: python3 -c 'import vtk' failed; the .vtu is not checked with VTK (CI installs it)");
+    // an independent reader: VTK
+    if !python::python_with(&["vtk"], "reading the strip's .vtu back with VTK") {
         return;
     }
     let vtu = out.join(last["vtu"].as_str().unwrap());

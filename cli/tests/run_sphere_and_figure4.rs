@@ -78,6 +78,14 @@ fn stamp_paper_plot_says_where_figure4_was_written() {
     assert!(run.status.success(), "stamp paper --plot failed: {}", String::from_utf8_lossy(&run.stderr));
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(stdout.contains("Table 2."), "the tables are printed first: {stdout}");
+    // what it cites is in the repository: the document and its section
+    assert!(!stdout.contains("SPEC"), "{stdout}");
+    let cited = stdout.split_whitespace().filter(|w| w.starts_with("docs/")).collect::<Vec<_>>();
+    assert!(!cited.is_empty(), "{stdout}");
+    for doc in cited {
+        let text = std::fs::read_to_string(repo().join(doc.trim_end_matches(|c: char| !c.is_alphanumeric()))).unwrap_or_else(|e| panic!("{doc}: {e}"));
+        assert!(text.contains("## The paper's benchmark"), "{doc}");
+    }
     let line = format!("stamp paper: Figure 4 written to {}, .svg, .csv", out.join("figure4.png").display());
     assert_eq!(stdout.lines().last(), Some(line.as_str()), "{stdout}");
     for name in ["figure4.png", "figure4.svg", "figure4.csv"] {

@@ -1,4 +1,4 @@
-//! `stamp paper`: the paper's section-5 benchmark (SPEC section 5). An infinitely long plate
+//! `stamp paper`: the paper's section-5 benchmark. An infinitely long plate
 //! (plane strain) of length 2l is bent around a fixed rigid cylinder by equal end forces towards
 //! the punch; the program reproduces the paper's Tables 1 and 2, the reaction check and Figure 4.
 //!

@@ -1,4 +1,4 @@
-//! Tables 1 and 2 of the paper (SPEC section 5): the paper's values, ours beside them, and the
+//! Tables 1 and 2 of the paper (its section 5): the paper's values, ours beside them, and the
 //! reaction check. Table 1: R = 1000 mm, each end carries P/2, linear and nonlinear; Table 2:
 //! R = 100 mm, each end carries P, nonlinear.
 
@@ -20,7 +20,7 @@ fn cmp(paper: f64, ours: f64) -> Compared {
     Compared { paper, ours, rel_diff: if paper != 0.0 { (ours - paper) / paper } else { ours - paper } }
 }
 
-/// Table 1 and 2 of the paper (SPEC section 5).
+/// Table 1 and 2 of the paper (its section 5).
 pub const TABLE1: [(f64, [f64; 3], [f64; 3]); 6] = [
     (0.1, [0.0, 0.0, 1.138], [0.0, 0.0, 1.138]),
     (0.3, [0.0, 2.5, 3.410], [0.0, 2.5, 3.407]),

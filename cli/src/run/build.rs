@@ -33,7 +33,7 @@
 use super::mesh::{group_error, MeshData};
 use super::rigid_modes::num;
 use super::plate_model::{Layout, Plate};
-use super::problem::{ContactKinematicsSpec, ContactSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape};
+use super::problem::{ContactKinematicsSpec, ContactSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape, DEFAULT_MAX_INCREMENT};
 use nalgebra::Vector3;
 use stamp::contact::{automatic_eps_reg, ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
@@ -106,9 +106,6 @@ fn add_force(model: &mut Model<Plate>, layout: &Layout, node: usize, f: [f64; 3]
     }
     Ok(())
 }
-
-/// The default largest load increment of `stamp run`.
-pub const DEFAULT_MAX_INCREMENT: f64 = 0.25;
 
 /// A mesh error of the plate elements or the model ("element 3 is inverted ...", "node 7 ...",
 /// 0-based indices) restated with the file and the user's numbers: the gmsh element or node tag,
@@ -197,7 +194,7 @@ fn build_coarse(p: &Problem, fine: &MeshData) -> Result<CoarseSetup> {
             span_key,
             format!(
                 "{what} does not cover the plate: {} of the mesh lies {} outside it (at most {} allowed, a fifth of its mean cell size); the coarse mesh must mesh the same plate",
-                super::check::where_node(fine, node),
+                super::mesh::where_node(fine, node),
                 num(distance),
                 num(allowed)
             ),

@@ -7,20 +7,27 @@
 //! * a punch that starts inside the plate by more than its penetration tolerance
 //!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness);
 //! * rigid-body motions held by nothing (see [`super::rigid_modes`]): the rows are the supports'
-//!   held components (fixed and prescribed dofs, plane strain) at their faces, and the normals of a
-//!   punch at the points where it touches the plate at the start (gap <= [`TOUCH`] times the model
+//!   held components (fixed and prescribed dofs, plane strain) at their faces, and the line x3 at
+//!   the points where a punch touches the plate at the start (gap <= [`TOUCH`] times the model
 //!   size, or the penetration tolerance), or, for a force-driven punch that touches nothing yet,
-//!   at the points closest to it (its travel is an unknown: it comes down onto them).
+//!   at the points closest to it (it comes down onto them). A frictionless punch meets the flat
+//!   face tangentially at the first contact, so it holds along the face normal only: grad Psi at
+//!   the nodes beside the contact line is tilted by the mesh (the node is not where the punch
+//!   touches), and counting the tilt as holding the plate in its plane passed plates that slide;
+//! * the travel of a force-driven punch held by nothing (see [`super::travel_modes`]): its
+//!   direction across x3, or a rigid motion of the plate held by that punch alone (plate and punch
+//!   move away together).
 //!
 //! Warnings (the solve goes on): a punch whose motion or force moves it away from its contact face;
 //! a punch on the side of the plate away from its contact face; after a run, a punch that never
 //! touched the plate or touched it on a zone narrower than the cells ([`after_the_run`]).
 
 use super::build::Setup;
-use super::mesh::MeshData;
+use super::mesh::{where_node, MeshData};
 use super::problem::{LoadFace, LoadKind, Problem};
 use super::punch_start::{first_gap, gap_at, start_gaps, PointGap};
-use super::rigid_modes::{num, RigidModes};
+use super::rigid_modes::{direction_words, join_and, num, RigidModes};
+use super::travel_modes::TravelModes;
 use nalgebra::Vector3;
 use stamp::dofs::PRESCRIBED;
 use stamp::nonlinear::NonlinearProblem;
@@ -89,18 +96,6 @@ fn bbox(mesh: &MeshData) -> ([f64; 2], [f64; 2]) {
         }
     }
     (lo, hi)
-}
-
-/// "node at (x1, x2) = (1, 2) (gmsh node 17)"; a node the reader or a refinement added (tag 0)
-/// has no gmsh tag to name.
-pub fn where_node(mesh: &MeshData, node: usize) -> String {
-    let x = mesh.mesh.coords[node];
-    let tag = match mesh.node_tags.as_ref().and_then(|t| t.get(node)) {
-        Some(0) => " (not a gmsh node: added where a cell was cut)".to_string(),
-        Some(t) => format!(" (gmsh node {t})"),
-        None => String::new(),
-    };
-    format!("the node at (x1, x2) = ({}, {}){tag}", num(x[0]), num(x[1]))
 }
 
 fn vec3(v: [f64; 3]) -> String {
@@ -234,36 +229,79 @@ fn check_rigid_modes(p: &Problem, setup: &Setup, starts: &[PunchStart], size: f6
         }
     }
     let supports_only = modes.describe_free();
+    let with_supports = modes.clone();
+    // a frictionless punch meets the flat face tangentially at the first contact: it holds the
+    // plate along the face normal x3 only, wherever it touches (the tilt of grad Psi at nodes
+    // beside the contact line is the mesh's, not the contact's)
     let mut holders = Vec::new();
     for s in starts {
         for g in &s.holding {
-            modes.hold(g.x, g.normal);
+            modes.hold(g.x, FACE_NORMAL_LINE);
         }
         if !s.holding.is_empty() {
             holders.push(format!("'{}'", s.name));
         }
     }
-    match modes.describe_free() {
-        None => Ok(match supports_only {
-            None => "all six held by the supports".into(),
-            Some(_) => format!("all six held by the supports and the punch{} {} at the start", if holders.len() > 1 { "es" } else { "" }, holders.join(", ")),
-        }),
-        Some(free) => {
-            let basis = modes.free_basis();
-            let involves = |idx: &[usize]| basis.iter().any(|b| idx.iter().any(|&i| b[i].abs() > 1e-6 * b.norm()));
-            let mut advice = Vec::new();
-            if involves(&[0, 1, 5]) {
-                advice.push("fix = [\"v1\", \"v2\"] on a point group and fix = [\"v2\"] on a second point, or symmetry conditions (symmetry_x1, symmetry_x2 on symmetry edges)");
-            }
-            if involves(&[2, 3, 4]) {
-                advice.push("fix = [\"simply_supported\"] on an edge or on three points not in a line, or a punch touching the plate at the start");
-            }
-            Err(StampError::Input {
-                file: file(p),
-                message: format!("boundary: {free} (no support holds them and no punch touches the plate there at the start): add supports, e.g. {}", advice.join("; ")),
-            })
+    if let Some(free) = modes.describe_free() {
+        let basis = modes.free_basis();
+        let involves = |idx: &[usize]| basis.iter().any(|b| idx.iter().any(|&i| b[i].abs() > 1e-6 * b.norm()));
+        let mut advice = Vec::new();
+        if involves(&[0, 1, 5]) {
+            advice.push("fix = [\"v1\", \"v2\"] on a point group and fix = [\"v2\"] on a second point, or symmetry conditions (symmetry_x1, symmetry_x2 on symmetry edges)");
+        }
+        if involves(&[2, 3, 4]) {
+            advice.push("fix = [\"simply_supported\"] on an edge or on three points not in a line, or a punch touching the plate at the start");
+        }
+        let why = if holders.is_empty() {
+            "no support holds them and no punch touches the plate at the start"
+        } else {
+            "no support holds them, and a frictionless punch holds the plate only along x3, the normal of the face it first touches"
+        };
+        return Err(StampError::Input { file: file(p), message: format!("boundary: {free} ({why}): add supports, e.g. {}", advice.join("; ")) });
+    }
+    check_travels(p, setup, starts, &with_supports)?;
+    Ok(match supports_only {
+        None => "all six held by the supports".into(),
+        Some(_) => format!("all six held by the supports and the punch{} {} at the start", if holders.len() > 1 { "es" } else { "" }, holders.join(", ")),
+    })
+}
+
+/// The line along which a punch holds the plate at the first contact: the face normal.
+const FACE_NORMAL_LINE: [f64; 3] = [0.0, 0.0, 1.0];
+
+/// Err when the travel of a force-driven punch is held by nothing: its direction is across x3
+/// (it slides past the plate), or it alone holds a rigid motion of the plate (plate and punch
+/// move away together and nothing takes its force). `supports` holds the supports' rows.
+fn check_travels(p: &Problem, setup: &Setup, starts: &[PunchStart], supports: &RigidModes) -> Result<()> {
+    let driven: Vec<usize> = (0..starts.len()).filter(|&i| setup.model.contacts[i].drive.is_some()).collect();
+    if driven.is_empty() {
+        return Ok(());
+    }
+    let mut t = TravelModes::new(supports, driven.len());
+    for (i, s) in starts.iter().enumerate() {
+        let travel = driven.iter().position(|&j| j == i).map(|k| (k, setup.model.contacts[i].drive.unwrap().direction));
+        for g in &s.holding {
+            t.hold(g.x, FACE_NORMAL_LINE, travel);
         }
     }
+    let Some(f) = t.free().into_iter().next() else { return Ok(()) };
+    let names: Vec<String> = driven.iter().zip(&f.travels).filter(|(_, w)| w.abs() > 1e-6).map(|(&i, _)| format!("'{}'", starts[i].name)).collect();
+    let (punches, its) = if names.len() == 1 { (format!("the force-driven punch {}", names[0]), "its") } else { (format!("the force-driven punches {}", join_and(&names.iter().map(|s| s.as_str()).collect::<Vec<_>>())), "their") };
+    let message = if f.plate_still {
+        let dirs: Vec<String> = driven.iter().zip(&f.travels).filter(|(_, w)| w.abs() > 1e-6).map(|(&i, _)| direction_words(&Vector3::from(setup.model.contacts[i].drive.unwrap().direction))).collect();
+        format!(
+            "boundary: the travel of {punches} (along {}) is held by nothing: at the first contact a frictionless punch pushes the plate only along x3, the normal of the face, and {its} direction has no x3 component; give {its} direction an x3 component, or drive it by motion",
+            dirs.join(", ")
+        )
+    } else {
+        format!(
+            "boundary: {} together with the travel of {punches} is held by nothing ({punches} alone hold{} the plate there, so nothing takes {its} force): add supports, e.g. fix = [\"simply_supported\"] on an edge or on three points not in a line, or drive {} by motion",
+            supports.describe_motion(&f.plate),
+            if names.len() == 1 { "s" } else { "" },
+            if names.len() == 1 { "it" } else { "them" }
+        )
+    };
+    Err(StampError::Input { file: file(p), message })
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -9,12 +9,10 @@
 //! (`stamp bench --one n`, 2026-11-24): n = 50 peaks at 0.077 GiB (estimate 0.13), n = 100 at
 //! 0.32 GiB (estimate 0.37).
 
-/// Unknowns per node of the paper's plate (three displacements on each face): what the problem
-/// file's mesh is checked against before its model is known.
-pub const DOFS_PER_NODE: u64 = 6;
-/// Unknowns per node of the plate a problem file chooses (three per surface).
-pub fn dofs_per_node(surfaces: super::problem::Surfaces) -> u64 {
-    3 * surfaces.0 as u64
+/// Unknowns per node of a plate of `surfaces` surfaces (the problem file's `[plate] surfaces`):
+/// three per surface.
+pub fn dofs_per_node(surfaces: impl Into<usize>) -> u64 {
+    3 * surfaces.into() as u64
 }
 
 /// Bytes per unknown and per factor of log2(unknowns) (see the calibration above).
@@ -68,6 +66,9 @@ pub fn check_against(nodes: u64, dofs_per_node: u64, available: Option<f64>) -> 
 mod tests {
     use super::*;
 
+    /// The paper's plate: three displacements on each of its two faces.
+    const DOFS_PER_NODE: u64 = 6;
+
     #[test]
     fn the_estimate_matches_the_bench_calibration() {
         // quarter plate n x n: (n + 1)^2 nodes; measured 1.36 GiB (n = 200) and 5.85 GiB (n = 400)
@@ -75,6 +76,12 @@ mod tests {
             let est = estimate_bytes((n + 1) * (n + 1), DOFS_PER_NODE) / GIB;
             assert!(est >= measured && est < 1.15 * measured, "n = {n}: {est} GiB against {measured}");
         }
+    }
+
+    #[test]
+    fn three_unknowns_per_surface() {
+        assert_eq!(dofs_per_node(2usize), DOFS_PER_NODE);
+        assert_eq!(dofs_per_node(5usize), 15);
     }
 
     #[test]

@@ -5,7 +5,9 @@
 //! group `all`, and the point groups `corner_ll` (a, c), `corner_lr` (b, c), `corner_ur` (b, d),
 //! `corner_ul` (a, d) and, when nx and ny are even, `center`.
 
+use super::memory::{check_model_fits, dofs_per_node};
 use super::problem::Problem;
+use super::rigid_modes::num;
 use stamp::io::read_msh;
 use stamp::mesh::QuadMesh;
 use stamp::{Result, StampError};
@@ -38,6 +40,14 @@ impl MeshData {
             Self::read(p, file, "mesh.file")
         } else {
             let r = spec.rectangle.as_ref().expect("checked: file or rectangle");
+            // refused before its nodes are allocated when its model cannot fit
+            let nodes = (r.n[0] as u64 + 1) * (r.n[1] as u64 + 1);
+            check_model_fits(nodes, dofs_per_node(p.spec.plate.get_ref().surfaces)).map_err(|e| {
+                // the `rectangle` key after the [mesh] header (its span is the header's)
+                let at = p.spec.mesh.span().start;
+                let at = p.source.get(at..).and_then(|t| t.find("rectangle")).map_or(at, |k| at + k);
+                p.error_at(at..at, "mesh.rectangle.n", format!("[{}, {}]: {e}", r.n[0], r.n[1]))
+            })?;
             Self::rectangle(r, r.n[0], r.n[1])
         }
     }
@@ -240,4 +250,16 @@ pub fn group_error(p: &Problem, span: std::ops::Range<usize>, key: &str, name: &
         names = names.chars().take(200).collect::<String>() + ", ...";
     }
     p.error_at(span, key, format!("no {want}group named '{}'; the mesh has: {names}", stamp::quote(name)))
+}
+
+/// "node at (x1, x2) = (1, 2) (gmsh node 17)"; a node the reader or a refinement added (tag 0)
+/// has no gmsh tag to name.
+pub fn where_node(mesh: &MeshData, node: usize) -> String {
+    let x = mesh.mesh.coords[node];
+    let tag = match mesh.node_tags.as_ref().and_then(|t| t.get(node)) {
+        Some(0) => " (not a gmsh node: added where a cell was cut)".to_string(),
+        Some(t) => format!(" (gmsh node {t})"),
+        None => String::new(),
+    };
+    format!("the node at (x1, x2) = ({}, {}){tag}", num(x[0]), num(x[1]))
 }

@@ -1,10 +1,13 @@
 //! `stamp run`: problem files, the generic solve pipeline and its outputs.
 //!
-//! * [`problem`]: the TOML schema (serde, `deny_unknown_fields`) and its checks;
-//! * [`mesh`]: the gmsh mesh or the built-in rectangle, with groups by dimension;
+//! * [`problem`]: the TOML schema (serde, `deny_unknown_fields`) and its checks; it depends on no
+//!   module below but [`units`] (the modules that build and run the model read it, not the reverse);
+//! * [`mesh`]: the gmsh mesh or the built-in rectangle, with groups by dimension (refused before it
+//!   is built when its model cannot fit in memory: [`memory`]);
 //! * [`build`]: section, plate elements, constraints, loads, punches, solver settings;
 //! * [`check`]: what is wrong with a built problem, said before the solve (`stamp check`), with
-//!   [`rigid_modes`] (rigid motions held by nothing) and [`punch_start`] (gaps at the start);
+//!   [`rigid_modes`] (rigid motions held by nothing), [`travel_modes`] (force-driven punches'
+//!   travels held by nothing) and [`punch_start`] (gaps at the start);
 //! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those);
 //! * [`solve`]: Newton-Raphson along the targets with a progress bar, writing every step;
 //! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step;
@@ -31,6 +34,7 @@ pub mod richardson;
 pub mod rigid_modes;
 pub mod solve;
 pub mod table;
+pub mod travel_modes;
 pub mod units;
 
 pub use problem::Problem;
@@ -96,4 +100,67 @@ pub fn run_command(problem: &Path, out: Option<&Path>, quiet: bool, refine: Opti
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    /// Each module of this folder and the modules of this folder its code names (`super::x`,
+    /// `crate::run::x`; comments left out).
+    fn uses() -> BTreeMap<String, Vec<String>> {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/run");
+        let mut graph = BTreeMap::new();
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let Some(name) = path.file_stem().and_then(|s| s.to_str()).filter(|_| path.extension().is_some_and(|e| e == "rs")) else { continue };
+            if name == "mod" {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            // the module's own code, not its tests (whose `use super::*` is the module itself)
+            let code = text.split("#[cfg(test)]").next().unwrap();
+            let mut deps: Vec<String> = Vec::new();
+            for line in code.lines().map(str::trim).filter(|l| !l.starts_with("//")) {
+                for prefix in ["super::", "crate::run::"] {
+                    for part in line.split(prefix).skip(1) {
+                        let dep: String = part.chars().take_while(|c| c.is_ascii_lowercase() || *c == '_').collect();
+                        if !dep.is_empty() && !deps.contains(&dep) {
+                            deps.push(dep);
+                        }
+                    }
+                }
+            }
+            graph.insert(name.to_string(), deps);
+        }
+        graph
+    }
+
+    #[test]
+    fn the_problem_schema_depends_on_no_model_module_and_no_module_imports_in_a_circle() {
+        let graph = uses();
+        assert_eq!(graph["problem"], vec!["units".to_string()], "problem.rs (the TOML schema) names {:?}", graph["problem"]);
+        assert!(graph["memory"].is_empty(), "{:?}", graph["memory"]);
+        // depth-first search for a cycle
+        fn visit(u: &str, graph: &BTreeMap<String, Vec<String>>, state: &mut BTreeMap<String, u8>, path: &mut Vec<String>) {
+            state.insert(u.to_string(), 1);
+            path.push(u.to_string());
+            for v in graph.get(u).into_iter().flatten().filter(|v| graph.contains_key(*v)) {
+                match state.get(v) {
+                    Some(1) => panic!("modules import each other in a circle: {} -> {v}", path.join(" -> ")),
+                    Some(_) => {}
+                    None => visit(v, graph, state, path),
+                }
+            }
+            path.pop();
+            state.insert(u.to_string(), 2);
+        }
+        let mut state = BTreeMap::new();
+        for u in graph.keys() {
+            if !state.contains_key(u) {
+                visit(u, &graph, &mut state, &mut Vec::new());
+            }
+        }
+        assert!(graph.len() > 15 && graph["check"].contains(&"build".to_string()), "the scan found the modules: {graph:?}");
+    }
 }

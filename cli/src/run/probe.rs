@@ -35,9 +35,8 @@ use super::history::{sig4, History, HistoryRow};
 use super::plate_model::Layout;
 use super::mesh::MeshData;
 use super::plot::{write_plot, Plot, Series};
-use super::problem::Problem;
+use super::problem::{Problem, ProbeSpec};
 use super::units::Units;
-use serde::Deserialize;
 use stamp::contact::ContactPair;
 use stamp::io::write_string_atomically;
 use stamp::mesh::{bilinear, inverse_bilinear, QuadMesh};
@@ -53,45 +52,6 @@ pub const DEFAULT_POINTS: usize = 200;
 /// area), and the number of lines across it that sample it.
 pub const BAND_CELLS: f64 = 8.0;
 const BAND_LINES: usize = 17;
-
-/// One `[[output.probe]]` table.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ProbeSpec {
-    pub name: String,
-    pub from: [f64; 2],
-    pub to: [f64; 2],
-    #[serde(default)]
-    pub points: Option<usize>,
-}
-
-/// Check the probes of a problem file (called by [`Problem::parse`]) (names, ends, number of points), with file, line and key.
-pub fn check_probes(p: &Problem, probes: &[Spanned<ProbeSpec>]) -> Result<()> {
-    let mut names = std::collections::BTreeSet::new();
-    for (i, s) in probes.iter().enumerate() {
-        let spec = s.get_ref();
-        let key = format!("output.probe[{i}]");
-        let name = &spec.name;
-        if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("{} must be 1 to 64 letters, digits, '_' or '-' (it names files)", stamp::quote(name))));
-        }
-        if !names.insert(name.clone()) {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("two probes are named {}", stamp::quote(name))));
-        }
-        if spec.from.iter().chain(&spec.to).any(|v| !v.is_finite()) {
-            return Err(p.error_at(s.span(), &key, format!("from = {:?} and to = {:?} must be finite", spec.from, spec.to)));
-        }
-        if spec.from == spec.to {
-            return Err(p.error_at(s.span(), &format!("{key}.to"), format!("the line has no length: from = to = {:?}", spec.from)));
-        }
-        if let Some(n) = spec.points {
-            if !(2..=100_000).contains(&n) {
-                return Err(p.error_at(s.span(), &format!("{key}.points"), format!("expected 2 to 100000 points, got {n}")));
-            }
-        }
-    }
-    Ok(())
-}
 
 // ---------------------------------------------------------------------------------------------
 // point location

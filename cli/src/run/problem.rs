@@ -344,9 +344,51 @@ pub struct MeshSpec {
     pub coarse_file: Option<Spanned<String>>,
 }
 
+/// The default largest load increment (`[solver] max_increment`).
+pub const DEFAULT_MAX_INCREMENT: f64 = 0.25;
+
+/// One `[[output.probe]]` table (the probe itself: probe.rs).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    pub name: String,
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+    #[serde(default)]
+    pub points: Option<usize>,
+}
+
+/// Check the probes of a problem file (called by [`Problem::parse`]; see probe.rs) (names, ends, number of points), with file, line and key.
+pub fn check_probes(p: &Problem, probes: &[Spanned<ProbeSpec>]) -> Result<()> {
+    let mut names = std::collections::BTreeSet::new();
+    for (i, s) in probes.iter().enumerate() {
+        let spec = s.get_ref();
+        let key = format!("output.probe[{i}]");
+        let name = &spec.name;
+        if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("{} must be 1 to 64 letters, digits, '_' or '-' (it names files)", stamp::quote(name))));
+        }
+        if !names.insert(name.clone()) {
+            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("two probes are named {}", stamp::quote(name))));
+        }
+        if spec.from.iter().chain(&spec.to).any(|v| !v.is_finite()) {
+            return Err(p.error_at(s.span(), &key, format!("from = {:?} and to = {:?} must be finite", spec.from, spec.to)));
+        }
+        if spec.from == spec.to {
+            return Err(p.error_at(s.span(), &format!("{key}.to"), format!("the line has no length: from = to = {:?}", spec.from)));
+        }
+        if let Some(n) = spec.points {
+            if !(2..=100_000).contains(&n) {
+                return Err(p.error_at(s.span(), &format!("{key}.points"), format!("expected 2 to 100000 points, got {n}")));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The built-in rectangle, checked while deserialising: finite increasing intervals with a finite
 /// extent, cells large enough for distinct node coordinates, and a node count (checked
-/// arithmetic) whose model fits in memory ([`super::memory`]).
+/// arithmetic). Whether its model fits in memory is checked before the mesh is built (mesh.rs).
 #[derive(Debug)]
 pub struct RectangleSpec {
     pub x: [f64; 2],
@@ -386,8 +428,7 @@ impl RectangleSpec {
             }
         }
         let (nx, ny) = (n[0] as u64, n[1] as u64);
-        let nodes = (nx + 1).checked_mul(ny + 1).ok_or_else(|| format!("mesh.rectangle.n: [{nx}, {ny}] gives more nodes than this machine can count"))?;
-        super::memory::check_model_fits(nodes, super::memory::DOFS_PER_NODE).map_err(|e| format!("mesh.rectangle.n: [{nx}, {ny}]: {e}"))?;
+        (nx + 1).checked_mul(ny + 1).ok_or_else(|| format!("mesh.rectangle.n: [{nx}, {ny}] gives more nodes than this machine can count"))?;
         Ok([nx as usize, ny as usize])
     }
 }
@@ -442,6 +483,11 @@ pub struct PlateSpec {
 /// `[plate] surfaces`: an integer from 2 to 5.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Surfaces(pub usize);
+impl From<Surfaces> for usize {
+    fn from(s: Surfaces) -> usize {
+        s.0
+    }
+}
 impl Default for Surfaces {
     fn default() -> Self {
         Surfaces(2)
@@ -691,12 +737,13 @@ pub struct OutputSpec {
     /// Every converged step (true) or the targets only (false).
     #[serde(default = "yes")]
     pub every_step: bool,
-    /// A node is in the loaded zone when |lambda| > loaded_threshold * max |lambda| (SPEC 6).
+    /// A node is in the loaded zone when |lambda| > loaded_threshold * max |lambda| (0.5 %: docs/verification.md,
+    /// "The paper's benchmark").
     #[serde(default = "default_threshold")]
     pub loaded_threshold: Fraction,
     /// Lines along which the fields are sampled (see probe.rs).
     #[serde(default)]
-    pub probe: Vec<Spanned<super::probe::ProbeSpec>>,
+    pub probe: Vec<Spanned<ProbeSpec>>,
 }
 
 fn yes() -> bool {
@@ -1057,7 +1104,7 @@ impl Problem {
             return Err(self.error_at(t.span(), "solver.targets", "give `targets` or `steps`, not both"));
         }
         self.check_increments()?;
-        super::probe::check_probes(self, &s.output.probe)?;
+        check_probes(self, &s.output.probe)?;
         if s.output.plot_axis == PlotAxis::Arc && s.output.plot_group.is_none() {
             return Err(StampError::Input {
                 file: self.path.display().to_string(),
@@ -1073,7 +1120,7 @@ impl Problem {
     fn check_increments(&self) -> Result<()> {
         let sv = &self.spec.solver;
         let defaults = stamp::nonlinear::NewtonSettings::default();
-        let max_inc = sv.max_increment.as_ref().map_or(super::build::DEFAULT_MAX_INCREMENT, |x| x.get_ref().0);
+        let max_inc = sv.max_increment.as_ref().map_or(DEFAULT_MAX_INCREMENT, |x| x.get_ref().0);
         let min_inc = sv.min_increment.as_ref().map_or(defaults.min_increment, |x| x.get_ref().0);
         // where to point: the key given, else the [solver] targets/steps, else the file
         let span_of = |k: &Option<Spanned<Increment>>| k.as_ref().map(|x| x.span()).or_else(|| sv.targets.as_ref().map(|t| t.span())).or_else(|| sv.steps.as_ref().map(|t| t.span()));

@@ -12,7 +12,7 @@
 //! diagonal (a correlation matrix, so that a mode held only by a short lever arm still counts as
 //! held) and its eigenvectors with eigenvalues below [`NULL_TOLERANCE`] span the free motions.
 
-use nalgebra::{DMatrix, Matrix6, SymmetricEigen, Vector3, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen, Vector3, Vector6};
 
 /// Eigenvalue of the unit-diagonal Gram matrix below which a combination of modes counts as free:
 /// the squared sine of the angle between a constraint column and the span of the others.
@@ -65,6 +65,11 @@ impl RigidModes {
         self.hold(x, d);
     }
 
+    /// The Gram matrix of the rows added, A^T A.
+    pub fn gram(&self) -> &Matrix6<f64> {
+        &self.gram
+    }
+
     /// Number of rows added.
     pub fn rows(&self) -> usize {
         self.rows
@@ -72,27 +77,8 @@ impl RigidModes {
 
     /// An orthonormal basis (in the scaled coordinates) of the combinations held by nothing.
     pub fn free_basis(&self) -> Vec<Vector6<f64>> {
-        let diag: Vector6<f64> = self.gram.diagonal();
-        let dmax = diag.max();
-        // a column with (next to) nothing in it is free on its own; the others are scaled to 1
-        let inv: Vector6<f64> = diag.map(|g| if g > 0.0 && g > 1e-20 * dmax { 1.0 / g.sqrt() } else { 0.0 });
-        let mut c = self.gram;
-        for i in 0..6 {
-            for j in 0..6 {
-                c[(i, j)] *= inv[i] * inv[j];
-            }
-        }
-        let eig = SymmetricEigen::new(c);
-        let mut basis: Vec<Vector6<f64>> = Vec::new();
-        for k in 0..6 {
-            if eig.eigenvalues[k] < NULL_TOLERANCE {
-                // back to unscaled coordinates: columns scaled to zero keep their own direction
-                let y = eig.eigenvectors.column(k).into_owned();
-                let v = Vector6::from_fn(|i, _| if inv[i] > 0.0 { y[i] * inv[i] } else { y[i] });
-                push_orthonormal(&mut basis, v);
-            }
-        }
-        basis
+        let g = DMatrix::from_fn(6, 6, |i, j| self.gram[(i, j)]);
+        null_basis(&g).into_iter().map(|v| Vector6::from_column_slice(v.as_slice())).collect()
     }
 
     /// The free motions in physical terms (translation, rotation about the origin).
@@ -110,7 +96,7 @@ impl RigidModes {
         let k = basis.len();
         let n = DMatrix::from_fn(6, k, |i, j| basis[j][i]);
         let in_span = |v: &Vector6<f64>| -> bool {
-            let dv = nalgebra::DVector::from_column_slice(v.as_slice());
+            let dv = DVector::from_column_slice(v.as_slice());
             let proj = &n * (n.transpose() * &dv);
             (dv - proj).norm() < 1e-6 * v.norm()
         };
@@ -131,7 +117,7 @@ impl RigidModes {
         let nw = n.rows(3, 3).into_owned();
         let svd = nw.clone().svd(true, true);
         for i in 0..3 {
-            let mut e = nalgebra::DVector::zeros(3);
+            let mut e = DVector::zeros(3);
             e[i] = 1.0;
             let Ok(c) = svd.solve(&e, 1e-9) else { continue };
             if (&nw * &c - &e).norm() > 1e-6 {
@@ -142,13 +128,17 @@ impl RigidModes {
             named.push(v6);
             let m = self.physical(&v6);
             // the axis passes through O + w x a / |w|^2; say where unless both translations across
-            // the axis are free (then any axis parallel to it is free)
+            // the axis are free (then any axis parallel to it is free); with one of them free, the
+            // axis may slide across it
             let across: Vec<usize> = (0..3).filter(|&j| j != i).collect();
-            let point = if across.iter().all(|j| translations.contains(j)) {
-                None
-            } else {
-                let p = self.clean(self.origin + m.rotation.cross(&m.translation) / m.rotation.norm_squared());
-                Some(format!("({}, {}) = ({}, {})", AXES[across[0]], AXES[across[1]], num(p[across[0]]), num(p[across[1]])))
+            let free_across: Vec<usize> = across.iter().copied().filter(|j| translations.contains(j)).collect();
+            let p = self.clean(self.origin + m.rotation.cross(&m.translation) / m.rotation.norm_squared());
+            let point = match free_across.len() {
+                2 => None,
+                // moving the axis along x_b adds a translation along x_a (free), along x_a one along
+                // x_b (held): x_a of the axis is fixed, x_b is any
+                1 => Some(format!("any axis in the plane {} = {}", AXES[free_across[0]], num(p[free_across[0]]))),
+                _ => Some(format!("the axis through ({}, {}) = ({}, {})", AXES[across[0]], AXES[across[1]], num(p[across[0]]), num(p[across[1]]))),
             };
             rotations.push((i, point));
         }
@@ -163,7 +153,7 @@ impl RigidModes {
         }
         for (i, point) in &rotations {
             if let Some(pt) = point {
-                parts.push(format!("the rotation about {} (about the axis through {pt})", AXES[*i]));
+                parts.push(format!("the rotation about {} (about {pt})", AXES[*i]));
             }
         }
         // whatever the names above do not cover: generic combinations
@@ -191,16 +181,92 @@ impl RigidModes {
         p.map(|x| if x.abs() < tiny { 0.0 } else { x })
     }
 
-    /// A motion that is not a coordinate translation or rotation, in words.
-    fn describe_motion(&self, m: &FreeMotion) -> String {
+    /// A rigid motion in words: "the translation along x1" or "... along (0.6, 0.8, 0)", "the
+    /// rotation about x3 (about the axis through (x1, x2) = (5, 3))" or "the rotation about the axis
+    /// along (0.6, 0.8, 0) through (5, 3, 0)". Components below [`ROUND_OFF`] of the largest are
+    /// round-off and set to zero, so that a coordinate axis is named by its name.
+    pub fn describe_motion(&self, m: &FreeMotion) -> String {
         let w = m.rotation.norm() * self.scale;
         if w < 1e-6 * m.translation.norm() {
-            let d = m.translation.normalize();
-            return format!("the translation along ({}, {}, {})", num(d[0]), num(d[1]), num(d[2]));
+            return format!("the translation along {}", direction_words(&m.translation));
         }
-        let axis = m.rotation.normalize();
+        let axis = snap(&m.rotation);
         let p = self.clean(self.origin + m.rotation.cross(&m.translation) / m.rotation.norm_squared());
-        format!("the rotation about the axis along ({}, {}, {}) through ({}, {}, {})", num(axis[0]), num(axis[1]), num(axis[2]), num(p[0]), num(p[1]), num(p[2]))
+        match coordinate_axis(&axis) {
+            Some(i) => {
+                let across: Vec<usize> = (0..3).filter(|&j| j != i).collect();
+                format!("the rotation about {} (about the axis through ({}, {}) = ({}, {}))", AXES[i], AXES[across[0]], AXES[across[1]], num(p[across[0]]), num(p[across[1]]))
+            }
+            None => format!("the rotation about the axis along {} through ({}, {}, {})", direction_words(&axis), num(p[0]), num(p[1]), num(p[2])),
+        }
+    }
+}
+
+/// Relative size below which a component of a direction is round-off.
+pub const ROUND_OFF: f64 = 1e-9;
+
+/// `v` scaled to unit length with the components below [`ROUND_OFF`] of the largest set to zero.
+pub fn snap(v: &Vector3<f64>) -> Vector3<f64> {
+    let big = v.amax();
+    if !(big > 0.0 && big.is_finite()) {
+        return *v;
+    }
+    v.map(|c| if c.abs() < ROUND_OFF * big { 0.0 } else { c }).normalize()
+}
+
+/// The coordinate axis (0, 1, 2) a snapped direction lies along, if any.
+pub fn coordinate_axis(d: &Vector3<f64>) -> Option<usize> {
+    let nonzero: Vec<usize> = (0..3).filter(|&i| d[i] != 0.0).collect();
+    (nonzero.len() == 1).then(|| nonzero[0])
+}
+
+/// A direction in words: "x1" for a coordinate axis (either sense) up to round-off, else the unit
+/// vector "(0.6, -0.8, 0)".
+pub fn direction_words(v: &Vector3<f64>) -> String {
+    let d = snap(v);
+    match coordinate_axis(&d) {
+        Some(i) => AXES[i].to_string(),
+        None => format!("({}, {}, {})", num(d[0]), num(d[1]), num(d[2])),
+    }
+}
+
+/// An orthonormal basis of the null space of the Gram matrix `gram` (A^T A of the constraint rows
+/// A): `gram` is scaled to unit diagonal first (a correlation matrix, so that a column held only by
+/// small entries still counts as held) and its eigenvectors with eigenvalues below
+/// [`NULL_TOLERANCE`] are taken back to the unscaled coordinates. A column with (next to) nothing
+/// in it is free on its own.
+pub fn null_basis(gram: &DMatrix<f64>) -> Vec<DVector<f64>> {
+    let n = gram.nrows();
+    let diag = gram.diagonal();
+    let dmax = diag.max();
+    let inv: DVector<f64> = diag.map(|g| if g > 0.0 && g > 1e-20 * dmax { 1.0 / g.sqrt() } else { 0.0 });
+    let c = DMatrix::from_fn(n, n, |i, j| gram[(i, j)] * inv[i] * inv[j]);
+    let eig = SymmetricEigen::new(c);
+    let mut basis: Vec<DVector<f64>> = Vec::new();
+    for k in 0..n {
+        if eig.eigenvalues[k] < NULL_TOLERANCE {
+            // back to unscaled coordinates: columns scaled to zero keep their own direction
+            let y = eig.eigenvectors.column(k).into_owned();
+            let v = DVector::from_fn(n, |i, _| if inv[i] > 0.0 { y[i] * inv[i] } else { y[i] });
+            push_orthonormal_d(&mut basis, v);
+        }
+    }
+    basis
+}
+
+/// Add `v` to an orthonormal list when it is not (nearly) in its span.
+fn push_orthonormal_d(basis: &mut Vec<DVector<f64>>, v: DVector<f64>) {
+    let norm0 = v.norm();
+    if norm0 == 0.0 {
+        return;
+    }
+    let mut r = v;
+    for b in basis.iter() {
+        let d = b.dot(&r);
+        r -= b * d;
+    }
+    if r.norm() > 1e-6 * norm0 {
+        basis.push(r.normalize());
     }
 }
 
@@ -314,6 +380,44 @@ mod tests {
         assert_eq!(m.describe_free().unwrap(), "the rotation about x2 (about the axis through (x1, x3) = (0, -5e-5)) is held by nothing");
         m.hold_component([0.0, 0.0, 5e-5], 0);
         assert!(m.describe_free().is_none(), "{:?}", m.describe_free());
+    }
+
+    #[test]
+    fn round_off_in_a_direction_is_dropped_and_coordinate_axes_are_named() {
+        assert_eq!(direction_words(&Vector3::new(-0.477886, 0.878422, 2.8206e-22)), "(-0.477886, 0.878422, 0)");
+        assert_eq!(direction_words(&Vector3::new(2.0, 3e-12, -1e-20)), "x1");
+        assert_eq!(direction_words(&Vector3::new(1e-15, -0.5, 0.0)), "x2", "either sense");
+        assert_eq!(direction_words(&Vector3::new(0.0, 0.0, 7.0)), "x3");
+        // 1e-6 of the largest is a real component
+        assert_eq!(direction_words(&Vector3::new(1.0, 1e-6, 0.0)), "(1, 1e-6, 0)");
+        let m = modes();
+        let along = |t: [f64; 3]| m.describe_motion(&FreeMotion { translation: Vector3::from(t), rotation: Vector3::zeros() });
+        assert_eq!(along([-3.0, 1e-14, 2.8e-22]), "the translation along x1");
+        assert_eq!(along([0.6, -0.8, 1e-17]), "the translation along (0.6, -0.8, 0)");
+        // a rotation about x3 up to round-off through (2, 7): u = w x (X - P) = w x (X - O) + w x (O - P)
+        let w = Vector3::new(1e-13, -2e-12, 0.25);
+        let about = |w: Vector3<f64>, p: [f64; 3]| m.describe_motion(&FreeMotion { translation: w.cross(&(Vector3::new(5.0, 3.0, 0.0) - Vector3::from(p))), rotation: w });
+        assert_eq!(about(w, [2.0, 7.0, 0.0]), "the rotation about x3 (about the axis through (x1, x2) = (2, 7))");
+        assert_eq!(about(Vector3::new(0.0, -1.0, 1e-12), [2.0, 7.0, -0.5]), "the rotation about x2 (about the axis through (x1, x3) = (2, -0.5))");
+        assert_eq!(about(Vector3::new(0.6, 0.0, 0.8), [5.0, 3.0, 0.0]), "the rotation about the axis along (0.6, 0, 0.8) through (5, 3, 0)");
+    }
+
+    #[test]
+    fn a_rotation_whose_axis_may_slide_names_the_plane_of_its_axes() {
+        // v3 held on the faces along x1 = 0 and x1 = 10, v2 at (0, 0): the translation along x1
+        // and the rotation about x3 about any axis through x1 = 0 (moving the axis along x2 adds a
+        // translation along x1, which is free)
+        let mut m = modes();
+        for x in grid() {
+            if x[0] == 0.0 || (x[0] - 10.0).abs() < 1e-12 {
+                for z in [-0.5, 0.5] {
+                    m.hold_component([x[0], x[1], z], 2);
+                }
+            }
+        }
+        m.hold_component([0.0, 0.0, 0.5], 1);
+        m.hold_component([0.0, 0.0, -0.5], 1);
+        assert_eq!(m.describe_free().unwrap(), "the translation along x1 and the rotation about x3 (about any axis in the plane x1 = 0) are held by nothing");
     }
 
     #[test]
