@@ -73,6 +73,25 @@ fn refused(case: &str, text: &str, at: Option<&str>, wanted: &[&str]) -> String 
     err
 }
 
+/// `stamp check` on the problem written by [`refused`] (or any file): (exit code, stderr).
+fn stamp_check(path: &Path) -> (Option<i32>, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(path).output().unwrap();
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// [`refused`] by `stamp run`, and by `stamp check` with the same message.
+fn refused_by_both(case: &str, text: &str, at: Option<&str>, wanted: &[&str]) -> String {
+    let err = refused(case, text, at, wanted);
+    let dir = temp_dir(&format!("badfile-check-{case}"));
+    let path = write(&dir, &format!("{case}.toml"), text);
+    let (code, check_err) = stamp_check(&path);
+    assert_eq!(code, Some(1), "{case}: stamp check: exit code {code:?}, stderr {check_err}");
+    for w in wanted {
+        assert!(check_err.contains(w), "{case}: stamp check: {w:?} not in: {check_err}");
+    }
+    err
+}
+
 fn solver(keys: &str) -> String {
     format!("{BASE}\n[solver]\n{keys}\n")
 }
@@ -93,6 +112,10 @@ fn step_counts_and_rectangle_sizes_out_of_range_are_refused() {
     // extents: finite, increasing, with a finite length, cells distinguishable
     refused("x_huge", &BASE.replace("x = [0.0, 1.0]", "x = [-1e308, 1e308]"), Some("rectangle"), &["mesh.rectangle.x", "magnitude at most 1e100", "[-1e308, 1e308]"]);
     refused("x_backwards", &BASE.replace("x = [0.0, 1.0]", "x = [1.0, 0.0]"), Some("rectangle"), &["mesh.rectangle.x", "increasing"]);
+    // a third number is not dropped
+    refused("x_three", &BASE.replace("x = [0.0, 1.0]", "x = [0.0, 1.0, 30.0]"), Some("rectangle"), &["mesh.rectangle.x", "exactly two numbers", "got 3"]);
+    refused("y_one", &BASE.replace("y = [0.0, 100.0]", "y = [100.0]"), Some("rectangle"), &["mesh.rectangle.y", "exactly two numbers", "got 1"]);
+    refused("n_three", &rect("n = [1, 40, 2]"), Some("rectangle"), &["mesh.rectangle.n", "exactly two numbers", "got 3"]);
     refused("y_tiny_cells", &BASE.replace("y = [0.0, 100.0]", "y = [1e6, 1.0000000000001e6]"), Some("rectangle"), &["mesh.rectangle.y", "too small to tell their nodes apart"]);
 }
 

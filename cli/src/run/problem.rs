@@ -357,9 +357,17 @@ pub struct RectangleSpec {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawRectangle {
-    x: [f64; 2],
-    y: [f64; 2],
-    n: [AnyNumber; 2],
+    // read as lists: serde's [f64; 2] takes the first two numbers of a longer array and drops the
+    // rest without a word
+    x: Vec<f64>,
+    y: Vec<f64>,
+    n: Vec<AnyNumber>,
+}
+
+/// Exactly two entries of `key`, else what is wrong.
+fn exactly_two<T>(key: &str, what: &str, v: Vec<T>) -> std::result::Result<[T; 2], String> {
+    let len = v.len();
+    <[T; 2]>::try_from(v).map_err(|_| format!("mesh.rectangle.{key}: expected exactly two numbers {what}, got {len}"))
 }
 
 impl RectangleSpec {
@@ -395,8 +403,11 @@ impl RectangleSpec {
 impl<'de> Deserialize<'de> for RectangleSpec {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let r = RawRectangle::deserialize(d)?;
-        let n = RectangleSpec::check(r.x, r.y, r.n).map_err(D::Error::custom)?;
-        Ok(RectangleSpec { x: r.x, y: r.y, n })
+        let x = exactly_two("x", "[x_min, x_max]", r.x).map_err(D::Error::custom)?;
+        let y = exactly_two("y", "[y_min, y_max]", r.y).map_err(D::Error::custom)?;
+        let n = exactly_two("n", "[cells along x, cells along y]", r.n).map_err(D::Error::custom)?;
+        let n = RectangleSpec::check(x, y, n).map_err(D::Error::custom)?;
+        Ok(RectangleSpec { x, y, n })
     }
 }
 
