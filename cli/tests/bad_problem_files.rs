@@ -120,6 +120,13 @@ fn step_counts_and_rectangle_sizes_out_of_range_are_refused() {
 }
 
 #[test]
+fn a_plot_group_the_mesh_lacks_is_refused_by_check_as_by_run() {
+    refused_by_both("plot_group", &format!("{BASE}\n[output]\nplot_group = \"nosuch\"\n"), Some("plot_group"), &["output.plot_group", "no group named 'nosuch'"]);
+    // arc needs a curve: the surface 'all' is not one
+    refused_by_both("plot_group_arc", &format!("{BASE}\n[output]\nplot_axis = \"arc\"\nplot_group = \"all\"\n"), Some("plot_group"), &["output.plot_group", "no curve group named 'all'"]);
+}
+
+#[test]
 fn load_paths_and_increments_that_cannot_end_are_refused() {
     refused("target_1e300", &solver("targets = [1e300]"), Some("targets ="), &["solver.targets", "at most 1e6", "1e300"]);
     refused("target_1e10", &solver("targets = [0.1, 1e10]"), Some("targets ="), &["solver.targets", "at most 1e6"]);

@@ -18,7 +18,7 @@
 
 use super::build::Setup;
 use super::mesh::MeshData;
-use super::problem::{LoadFace, LoadKind, Problem};
+use super::problem::{LoadFace, LoadKind, PlotAxis, Problem};
 use super::punch_start::{first_gap, gap_at, start_gaps, PointGap};
 use super::rigid_modes::{num, RigidModes};
 use nalgebra::Vector3;
@@ -148,6 +148,15 @@ fn check_groups(p: &Problem, mesh: &MeshData) -> Result<()> {
             if mesh.nodes(g.get_ref()).is_some_and(|n| n.is_empty()) {
                 return Err(empty(g.span(), &format!("punch[{i}].group"), g.get_ref(), "has no nodes: the punch has no point that may touch"));
             }
+        }
+    }
+    // the plot group as the run reads it (a curve for plot_axis = "arc", any group else)
+    if let Some(g) = &s.output.plot_group {
+        let name = g.get_ref();
+        let found = if s.output.plot_axis == PlotAxis::Arc { mesh.curve_chain(name).is_some() } else { mesh.nodes(name).is_some() };
+        if !found {
+            let kind = if s.output.plot_axis == PlotAxis::Arc { "curve" } else { "" };
+            return Err(super::mesh::group_error(p, g.span(), "output.plot_group", name, kind, mesh));
         }
     }
     Ok(())
