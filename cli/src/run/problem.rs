@@ -967,11 +967,15 @@ impl Problem {
                     if ls.force.is_some() || ls.pressure.is_some() || ls.face.is_some() {
                         return Err(self.error_at(l.span(), &key, "a moment load takes `moment` (and no `force`, `pressure` or `face`: it acts through both faces)"));
                     }
-                    if !ls.follower && m.0[2] != 0.0 {
+                    // the plate's fibre carries no twist about itself: the part of the couple along
+                    // the fibre is dropped (all of m3 at the start, fixed or follower alike)
+                    if m.0[2] != 0.0 {
+                        let kind = if ls.follower { "a follower couple (follower = true)" } else { "a fixed couple (follower = false)" };
+                        let whole = if m.0[0] == 0.0 && m.0[1] == 0.0 { " (with m1 = m2 = 0 the whole load would be dropped)" } else { "" };
                         return Err(self.error_at(
                             l.span(),
                             &format!("{key}.moment"),
-                            format!("a fixed couple (follower = false) cannot twist about the plate's normal: m3 must be 0, got {}", num(m.0[2])),
+                            format!("{kind} cannot twist about the plate's normal: m3 must be 0, got {}{whole}", num(m.0[2])),
                         ));
                     }
                 }
