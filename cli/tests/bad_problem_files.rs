@@ -127,6 +127,21 @@ fn a_plot_group_the_mesh_lacks_is_refused_by_check_as_by_run() {
 }
 
 #[test]
+fn a_number_with_a_unit_is_told_that_units_are_labels() {
+    for (case, from, to, shown) in [
+        ("unit_E", "E = 2.0e4", "E = 210 GPa", "'210 GPa'"),
+        ("unit_glued", "E = 2.0e4", "E = 2e4MPa", "'2e4 MPa'"),
+        ("unit_thickness", "thickness = 2.0", "thickness = 2 mm", "'2 mm'"),
+        ("unit_in_array", "force = [0.0, 0.0, 0.05]", "force = [0.0, 0.0, 0.05 N/mm]", "'0.05 N/mm'"),
+    ] {
+        let e = refused(case, &BASE.replace(from, to), Some(to), &[shown, "number followed by a unit", "[units]"]);
+        assert!(!e.contains("must be quoted"), "{case}: {e}");
+    }
+    // a word that is no number keeps toml's message
+    refused("bare_word", &BASE.replace("E = 2.0e4", "E = steel"), Some("E = steel"), &["plate.E"]);
+}
+
+#[test]
 fn load_paths_and_increments_that_cannot_end_are_refused() {
     refused("target_1e300", &solver("targets = [1e300]"), Some("targets ="), &["solver.targets", "at most 1e6", "1e300"]);
     refused("target_1e10", &solver("targets = [0.1, 1e10]"), Some("targets ="), &["solver.targets", "at most 1e6"]);

@@ -743,12 +743,37 @@ fn toml_message(source: &str, e: &toml::de::Error) -> String {
     let what = quote_long(&what.join(" "), 300);
     let Some(span) = e.span() else { return what };
     let (line, col) = line_col_of(source, span.start);
+    // `E = 210 GPa`: toml asks for quotes, but the value is meant as a number
+    // (toml may point inside the value, at the unit of `2e4MPa`: back to the value's start)
+    let before = source.get(..span.start).unwrap_or("");
+    let value_start = before.trim_end_matches(|c: char| c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | '_' | 'e' | 'E')).len();
+    let what = match number_with_unit(source.get(value_start..).unwrap_or("")) {
+        Some((number, unit)) => format!(
+            "'{}' is a number followed by a unit: values are plain numbers in the file's own consistent units (write {}); unit names are labels, given once in [units] (length, force, pressure)",
+            quote(&format!("{number} {unit}")),
+            quote(number)
+        ),
+        None => what,
+    };
     let what = match key_at(source, line, col) {
         // our own checks may name the key already ("mesh.rectangle.n: ...")
         Some(key) if !what.starts_with(&key) => format!("{}: {what}", quote(&key)),
         _ => what,
     };
     format!("line {line}, column {col}: {what}\n{}", source_window(source, line, col))
+}
+
+/// A value written as a number followed by a unit word (`210 GPa`, `2mm`, `0.05 N/mm`): the
+/// number and the unit, else None. `text` starts at the value.
+fn number_with_unit(text: &str) -> Option<(&str, &str)> {
+    let line = text.lines().next()?;
+    let end = line.find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | '_' | 'e' | 'E'))).unwrap_or(line.len());
+    // the longest prefix that is a number ("2e4MPa": "2e4"; "5em": "5")
+    let (number, rest) = (1..=end).rev().map(|k| line.split_at(k)).find(|(n, _)| n.replace('_', "").parse::<f64>().is_ok())?;
+    let rest = rest.trim_start();
+    let unit_end = rest.find(|c: char| c.is_whitespace() || matches!(c, ',' | ']' | '}' | '#')).unwrap_or(rest.len());
+    let unit = &rest[..unit_end];
+    unit.chars().next().is_some_and(|c| c.is_alphabetic() || c == '%').then_some((number, unit))
 }
 
 /// "  L | <the line around the column>": the problem file's line under an error (at most 60
