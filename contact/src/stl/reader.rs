@@ -6,6 +6,10 @@
 //! The facet normal stored in the file is ignored: the orientation is the vertex order
 //! (counter-clockwise seen from the side the normal points to, the STL convention).
 //!
+//! An ASCII file may hold several solids one after the other (`solid` ... `endsolid`, as CAD
+//! programs write a body of several parts): the die is all their facets together. Anything else
+//! after the last `endsolid`, or between `solid` and the first `facet`, is refused with its line.
+//!
 //! Binary or ASCII: a file whose size is exactly 84 + 50 N bytes, N the count in its header, is
 //! binary; otherwise a file starting with `solid` is ASCII; anything else is a binary file whose
 //! size does not match its header (truncated or padded). The header's count is checked against the
@@ -125,7 +129,7 @@ fn read_ascii(path: &Path, bytes: &[u8], max_facets: usize) -> Result<Soup> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         input_error(path, format!("ASCII STL: not valid text at byte {} (nor a binary STL of matching size)", e.valid_up_to()))
     })?;
-    let mut tokens = text
+    let tokens = text
         .lines()
         .enumerate()
         .flat_map(|(l, line)| line.split_whitespace().map(move |t| (l + 1, t)));
@@ -138,44 +142,58 @@ fn read_ascii(path: &Path, bytes: &[u8], max_facets: usize) -> Result<Soup> {
             None => Err(input_error(path, format!("facet {facet}: the file ends where `{want}` is expected"))),
         }
     };
-    // `solid` and its optional name, up to the first `facet` or `endsolid`
-    tokens.next();
-    let mut next = tokens.next();
-    while let Some((_, t)) = next {
-        if t == "facet" || t == "endsolid" {
-            break;
-        }
-        next = tokens.next();
-    }
+    // one or more solids, each `solid [name]` ... `endsolid [name]` (the names on the keyword's own
+    // line); after the last, nothing but blanks: a word anywhere else is refused with its line
+    let mut tokens = tokens.peekable();
+    let mut solids = 0usize;
     loop {
-        let facet = soup.len() + 1;
-        match next {
-            Some((_, "facet")) => {}
-            Some((_, "endsolid")) => break,
-            Some((l, t)) => return Err(err(l, format!("expected `facet` or `endsolid`, found '{}'", quote(t)))),
-            None => return Err(input_error(path, format!("ASCII STL: the file ends after {} facets without `endsolid`", soup.len()))),
-        }
-        if soup.len() >= max_facets {
-            return Err(too_many(path, format!("more than {max_facets} facets"), max_facets));
-        }
-        expect(tokens.next(), "normal", facet)?;
-        for _ in 0..3 {
-            number(path, tokens.next(), facet)?;
-        }
-        expect(tokens.next(), "outer", facet)?;
-        expect(tokens.next(), "loop", facet)?;
-        let mut v = [[0.0; 3]; 3];
-        for vertex in v.iter_mut() {
-            expect(tokens.next(), "vertex", facet)?;
-            for c in vertex.iter_mut() {
-                *c = number(path, tokens.next(), facet)?;
+        match tokens.next() {
+            // the file starts with `solid` (checked): its first word may run into the name
+            Some((l, t)) if t == "solid" || (solids == 0 && t.starts_with("solid")) => {
+                while tokens.peek().is_some_and(|&(l2, _)| l2 == l) {
+                    tokens.next();
+                }
             }
+            Some((l, t)) => {
+                return Err(err(l, format!("after `endsolid` of solid {solids}: expected `solid` (another solid) or the end of the file, found '{}'", quote(t))));
+            }
+            None => break,
         }
-        expect(tokens.next(), "endloop", facet)?;
-        expect(tokens.next(), "endfacet", facet)?;
-        check_finite(path, facet, &v)?;
-        soup.push(v);
-        next = tokens.next();
+        solids += 1;
+        loop {
+            let facet = soup.len() + 1;
+            match tokens.next() {
+                Some((_, "facet")) => {}
+                Some((l, "endsolid")) => {
+                    while tokens.peek().is_some_and(|&(l2, _)| l2 == l) {
+                        tokens.next();
+                    }
+                    break;
+                }
+                Some((l, t)) => return Err(err(l, format!("expected `facet` or `endsolid`, found '{}'", quote(t)))),
+                None => return Err(input_error(path, format!("ASCII STL: the file ends after {} facets without `endsolid`", soup.len()))),
+            }
+            if soup.len() >= max_facets {
+                return Err(too_many(path, format!("more than {max_facets} facets"), max_facets));
+            }
+            expect(tokens.next(), "normal", facet)?;
+            for _ in 0..3 {
+                number(path, tokens.next(), facet)?;
+            }
+            expect(tokens.next(), "outer", facet)?;
+            expect(tokens.next(), "loop", facet)?;
+            let mut v = [[0.0; 3]; 3];
+            for vertex in v.iter_mut() {
+                expect(tokens.next(), "vertex", facet)?;
+                for c in vertex.iter_mut() {
+                    *c = number(path, tokens.next(), facet)?;
+                }
+            }
+            expect(tokens.next(), "endloop", facet)?;
+            expect(tokens.next(), "endfacet", facet)?;
+            check_finite(path, facet, &v)?;
+            soup.push(v);
+        }
     }
     Ok(soup)
 }
