@@ -203,6 +203,34 @@ fn user_strings_are_bounded_and_vectors_show_tiny_values() {
 }
 
 #[test]
+fn long_file_names_are_shortened_in_messages() {
+    // a mesh or STL file key of 5000 characters: the message keeps the path's start and end
+    let mesh = format!("{}.msh", "m".repeat(5000));
+    let e = refused("long_mesh", &BASE.replace("rectangle = { x = [0.0, 1.0], y = [0.0, 100.0], n = [1, 40] }", &format!("file = \"{mesh}\"")), Some("file ="), &["mesh.file", "does not exist", "characters)...mmm", "mmm.msh"]);
+    assert!(e.chars().count() < 480, "{e}");
+    let stl = format!("{}.stl", "s".repeat(5000));
+    let text = format!("{BASE}{}", PUNCH.replace("shape = \"cylinder\"\npoint = [0.0, 50.0, 5.0]\naxis = [1.0, 0.0, 0.0]\nradius = 4.0\n", &format!("shape = \"stl\"\nfile = \"{stl}\"\n")));
+    let e = refused("long_stl", &text, Some("file ="), &["punch[0].file", "sss.stl"]);
+    assert!(e.chars().count() < 480, "{e}");
+    // a problem file 2000 characters deep (folders of 200): the message names it short, and the
+    // warnings of stamp check too
+    let mut dir = temp_dir("badfile-deep");
+    for _ in 0..10 {
+        dir = dir.join("d".repeat(200));
+    }
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = write(&dir, "deep.toml", &BASE.replace("E = 2.0e4", "E = -1.0"));
+    let (code, err) = stamp_run(&path, &dir.join("out"), Duration::from_secs(20));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("dd/deep.toml: line 7") && err.contains("characters)...") && err.chars().count() < 480, "{err}");
+    let away = format!("{BASE}{}", PUNCH.replace("motion = [0.0, 0.0, -1.0]", "motion = [0.0, 0.0, 1.0]"));
+    let path = write(&dir, "away.toml", &away);
+    let (code, err) = stamp_check(&path);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("dd/away.toml: punch[0]") && err.contains("moves it away") && err.chars().count() < 480, "{err}");
+}
+
+#[test]
 fn only_regular_files_are_read() {
     let dir = temp_dir("badfile-fifo");
     let fifo = dir.join("fifo.toml");

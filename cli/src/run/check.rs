@@ -282,7 +282,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
     let mut out = Vec::new();
     let h = setup.section.thickness();
     for (i, (info, pair)) in setup.punches.iter().zip(&setup.model.contacts).enumerate() {
-        let head = format!("{}: punch[{i}] ('{}')", file(p), quote(&info.name));
+        let head = format!("{}: punch[{i}] ('{}')", stamp::show_path(&p.path), quote(&info.name));
         let n_face = face_normal(info.face);
         let face = face_word(info.face);
         let sign = if info.face == Face::Top { "+" } else { "-" };
@@ -340,7 +340,7 @@ pub fn never_touched(p: &Problem, summary: &Path) -> Vec<String> {
         if counts.len() == converged.len() && counts.iter().all(|&c| c == 0) {
             out.push(format!(
                 "{}: punch[{i}] ('{}') never touched the plate: no node was in contact at any of the {} recorded steps; check its position, motion and face",
-                file(p),
+                stamp::show_path(&p.path),
                 quote(&name),
                 converged.len()
             ));
