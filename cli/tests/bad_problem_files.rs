@@ -142,6 +142,21 @@ fn a_number_with_a_unit_is_told_that_units_are_labels() {
 }
 
 #[test]
+fn a_punch_that_starts_between_the_faces_is_refused() {
+    // thickness 2000 where 2 was meant: the roller (z from 1 to 9) sits inside the plate
+    let text = format!("{}{PUNCH}", BASE.replace("thickness = 2.0", "thickness = 2000"));
+    refused_by_both("buried", &text, Some("[[punch]]"), &["punch[0]", "'roller' starts inside the plate's volume", "between the faces x3 = -1000 and 1000", "plate.thickness"]);
+    // a ball in the lower half of the thick plate
+    let ball = PUNCH.replace("shape = \"cylinder\"\npoint = [0.0, 50.0, 5.0]\naxis = [1.0, 0.0, 0.0]\nradius = 4.0", "shape = \"sphere\"\ncenter = [0.5, 50.0, -500.0]\nradius = 10.0");
+    let text = format!("{}{ball}", BASE.replace("thickness = 2.0", "thickness = 2000"));
+    refused_by_both("buried_ball", &text, Some("[[punch]]"), &["punch[0]", "starts inside the plate's volume", "x3 = -490"]);
+    // the thickness meant: no error
+    let dir = temp_dir("badfile-buried-ok");
+    let (code, err) = stamp_check(&write(&dir, "ok.toml", &format!("{BASE}{PUNCH}")));
+    assert_eq!(code, Some(0), "{err}");
+}
+
+#[test]
 fn load_paths_and_increments_that_cannot_end_are_refused() {
     refused("target_1e300", &solver("targets = [1e300]"), Some("targets ="), &["solver.targets", "at most 1e6", "1e300"]);
     refused("target_1e10", &solver("targets = [0.1, 1e10]"), Some("targets ="), &["solver.targets", "at most 1e6"]);

@@ -5,7 +5,8 @@
 //! * a support, load or punch on a group with nothing in it (no nodes; a line load on a curve with
 //!   no edges; a pressure or surface load on a surface with no cells);
 //! * a punch that starts inside the plate by more than its penetration tolerance
-//!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness);
+//!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness), at its
+//!   contact face or anywhere between the faces (the plate's volume: [`inside_volume`]);
 //! * rigid-body motions held by nothing (see [`super::rigid_modes`]): the rows are the supports'
 //!   held components (fixed and prescribed dofs, plane strain) at their faces, and the normals of a
 //!   punch at the points where it touches the plate at the start (gap <= [`TOUCH`] times the model
@@ -195,6 +196,7 @@ fn punch_start(p: &Problem, setup: &Setup, i: usize, size: f64) -> Result<PunchS
             ));
         }
     }
+    inside_volume(p, setup, i, &gaps, tol)?;
     let touch = (TOUCH * size).max(p.spec.punch[i].get_ref().penetration_tolerance.as_ref().map(|t| t.get_ref().0).unwrap_or(0.0));
     let mut holding: Vec<PointGap> = gaps.iter().filter(|g| g.gap <= touch).copied().collect();
     let touching = !holding.is_empty();
@@ -204,6 +206,41 @@ fn punch_start(p: &Problem, setup: &Setup, i: usize, size: f64) -> Result<PunchS
         }
     }
     Ok(PunchStart { key, name: info.name.clone(), first, holding, touching })
+}
+
+/// Err when punch `i` starts inside the plate's volume, between its faces (deeper than the
+/// penetration tolerance `tol` from either face): where the flow from a candidate point meets the
+/// punch's surface, or a point of the mid-plane under a candidate point inside the punch. The
+/// face check above cannot see it (`thickness = 2000` where 2 was meant: the punch sits between
+/// the faces, away from both).
+fn inside_volume(p: &Problem, setup: &Setup, i: usize, gaps: &[PointGap], tol: f64) -> Result<()> {
+    let (dm, dp) = (setup.section.delta_minus, setup.section.delta_plus);
+    let pair = &setup.model.contacts[i];
+    let info = &setup.punches[i];
+    let between = |z: f64| z > dm + tol && z < dp - tol;
+    let mid = 0.5 * (dm + dp);
+    let found = gaps.iter().find_map(|g| g.foot.filter(|f| between(f[2])).map(|f| (g.node, f[2], "its surface passes")));
+    let found = found.or_else(|| {
+        gaps.iter().find_map(|g| {
+            let x = Vector3::new(g.x[0], g.x[1], mid);
+            let (psi, grad) = (pair.surface.psi(&x), pair.surface.gradient(&x).norm());
+            (psi < 0.0 && psi.is_finite() && grad.is_finite() && psi < -tol * grad).then_some((g.node, mid, "the mid-plane is inside it"))
+        })
+    });
+    let Some((node, z, what)) = found else { return Ok(()) };
+    Err(p.error_at(
+        p.spec.punch[i].span(),
+        &format!("punch[{i}]"),
+        format!(
+            "'{}' starts inside the plate's volume: {what} at x3 = {}, on the fibre of {}, between the faces x3 = {} and {} (thickness {}); is plate.thickness right, or the punch's position?",
+            quote(&info.name),
+            num(z),
+            where_node(&setup.mesh, node),
+            num(dm),
+            num(dp),
+            num(dp - dm)
+        ),
+    ))
 }
 
 fn face_word(f: Face) -> &'static str {
