@@ -7,6 +7,8 @@
 //! * a punch that starts inside the plate by more than its penetration tolerance
 //!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness), at its
 //!   contact face or anywhere between the faces (the plate's volume: [`inside_volume`]);
+//! * an expression punch without a usable gradient of Psi along its motion
+//!   ([`super::psi_checks`]);
 //! * rigid-body motions held by nothing (see [`super::rigid_modes`]): the rows are the supports'
 //!   held components (fixed and prescribed dofs, plane strain) at their faces, and the normals of a
 //!   punch at the points where it touches the plate at the start (gap <= [`TOUCH`] times the model
@@ -62,6 +64,7 @@ pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
     let size = model_size(setup);
     let mut starts = Vec::new();
     for i in 0..setup.punches.len() {
+        super::psi_checks::check_expression(p, setup, i, size)?;
         starts.push(punch_start(p, setup, i, size)?);
     }
     let rigid = check_rigid_modes(p, setup, &starts, size)?;
