@@ -73,8 +73,9 @@ pub fn gradient_problem(psi: f64, g: &Vector3<f64>, size: f64) -> Option<String>
 }
 
 /// The load factors at which the start check samples the motion: 0, the targets, the path's rows
-/// up to the largest target and points between them, at most [`MOTION_SAMPLES`].
-fn motion_samples(motion: &PunchMotion, targets: &[f64]) -> Vec<f64> {
+/// up to the largest target and points between them, at most `most` (and [`MOTION_SAMPLES`]) and
+/// the last.
+fn motion_samples(motion: &PunchMotion, targets: &[f64], most: usize) -> Vec<f64> {
     let end = targets.iter().cloned().fold(0.0, f64::max);
     let mut t: Vec<f64> = std::iter::once(0.0).chain(targets.iter().copied()).collect();
     if let PunchMotion::Path(rows) = motion {
@@ -89,9 +90,10 @@ fn motion_samples(motion: &PunchMotion, targets: &[f64]) -> Vec<f64> {
         }
     }
     all.extend(t.last());
-    if all.len() > MOTION_SAMPLES {
-        let step = all.len() as f64 / MOTION_SAMPLES as f64;
-        all = (0..MOTION_SAMPLES).map(|k| all[(k as f64 * step) as usize]).chain(all.last().copied()).collect();
+    let most = most.clamp(1, MOTION_SAMPLES);
+    if all.len() > most {
+        let step = all.len() as f64 / most as f64;
+        all = (0..most).map(|k| all[(k as f64 * step) as usize]).chain(all.last().copied()).collect();
     }
     all
 }
@@ -104,7 +106,9 @@ pub fn check_expression(p: &Problem, setup: &Setup, i: usize, size: f64) -> Resu
     let spec = p.spec.punch[i].get_ref();
     let (Shape::Expression, Some(psi_key)) = (spec.shape, spec.psi.as_ref()) else { return Ok(()) };
     let pair = &setup.model.contacts[i];
-    let samples = if pair.drive.is_some() { vec![0.0] } else { motion_samples(&pair.motion, &setup.targets) };
+    // (about 2 million evaluations at most: a few seconds on the largest meshes)
+    let most = 2_000_000 / pair.points.len().max(1);
+    let samples = if pair.drive.is_some() { vec![0.0] } else { motion_samples(&pair.motion, &setup.targets, most) };
     let mut usable = false;
     let mut covered_without: Option<(usize, f64, String)> = None;
     let mut first_problem: Option<String> = None;
@@ -207,6 +211,14 @@ fn swept_through(p: &Problem, mesh: &MeshData, c: &ContactPair, i: usize, layout
             (psi < 0.0 && gn > 0.0 && psi / gn < -1e-9 * (dp - dm)).then_some(q.node)
         })
     };
+    // to reach the far face from outside the plate the punch moves at least half the thickness
+    // (its penetration at a converged end is far below that): shorter motions need no samples
+    let mut knots: Vec<f64> = std::iter::once(lo).chain(rows.iter().map(|r| r.1)).chain(std::iter::once(hi)).collect();
+    knots.dedup();
+    let travel: f64 = knots.windows(2).map(|w| Vector3::from(c.motion.displacement(w[1])).metric_distance(&Vector3::from(c.motion.displacement(w[0])))).sum();
+    if travel < 0.5 * (dp - dm) {
+        return None;
+    }
     let end0 = |k: usize| u0[k];
     let end1 = |k: usize| u1[k];
     if inside(t0, &end0).is_some() || inside(t1, &end1).is_some() {
@@ -215,7 +227,7 @@ fn swept_through(p: &Problem, mesh: &MeshData, c: &ContactPair, i: usize, layout
     for &t in &samples {
         // the plate as at either end of the step (not interpolated: a bent plate's points
         // interpolated linearly cut the chord, towards a punch it wraps)
-        if let (Some(node), Some(_)) = (inside(t, &end0), inside(t, &end1)) {
+        if let Some(node) = inside(t, &end0).filter(|_| inside(t, &end1).is_some()) {
             let rows_text = match rows.as_slice() {
                 [] => String::new(),
                 [(_, t)] => format!(" (the path's row at t = {} lies inside the step)", num(*t)),
@@ -271,13 +283,13 @@ mod tests {
     #[test]
     fn motion_samples_hold_the_targets_and_the_path_rows() {
         let path = PunchMotion::path(&[(0.3, [0.0, 0.0, -1.0]), (0.7, [0.0, 0.0, 0.0]), (2.0, [0.0, 0.0, -5.0])]).unwrap();
-        let t = motion_samples(&path, &[0.5, 1.0]);
+        let t = motion_samples(&path, &[0.5, 1.0], MOTION_SAMPLES);
         for want in [0.0, 0.3, 0.5, 0.7, 1.0] {
             assert!(t.contains(&want), "{want} not in {t:?}");
         }
         assert!(t.iter().all(|&x| x <= 1.0), "{t:?}");
         let many: Vec<f64> = (1..=1000).map(|k| k as f64 / 1000.0).collect();
-        let t = motion_samples(&PunchMotion::Linear([0.0, 0.0, -1.0]), &many);
+        let t = motion_samples(&PunchMotion::Linear([0.0, 0.0, -1.0]), &many, MOTION_SAMPLES);
         assert!(t.len() <= MOTION_SAMPLES + 1 && t[0] == 0.0 && *t.last().unwrap() == 1.0, "{}", t.len());
     }
 
