@@ -6,7 +6,7 @@
 //!   no edges; a pressure or surface load on a surface with no cells);
 //! * a punch that starts inside the plate by more than its penetration tolerance
 //!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness), at its
-//!   contact face or anywhere between the faces (the plate's volume: [`inside_volume`]);
+//!   contact face or anywhere between the faces (the plate's volume);
 //! * an expression punch without a usable gradient of Psi along its motion
 //!   ([`super::psi_checks`]);
 //! * rigid-body motions held by nothing (see [`super::rigid_modes`]): the rows are the supports'
