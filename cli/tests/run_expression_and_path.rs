@@ -229,6 +229,9 @@ fn a_path_that_carries_the_punch_through_the_plate_within_a_step_is_refused() {
     ] {
         let dir = temp_dir(case);
         let p = write(&dir, &format!("{case}.toml"), &format!("{base}\n[solver]\n{solver}\n"));
+        // stamp check foresees it (a warning: the solver's increments may be smaller)
+        let o = stamp(&["check"], &p);
+        assert!(o.ok && o.stderr.contains(&format!("warning: {}: increments of max_increment", p.display())) && o.stderr.contains("carries 'roller' through the plate"), "{case}: {}", o.stderr);
         let out = dir.join("out");
         let o = stamp(&["run", "-q", "--out", out.to_str().unwrap()], &p);
         assert!(!o.ok, "{case}: the run passed");
@@ -248,4 +251,6 @@ fn a_path_that_carries_the_punch_through_the_plate_within_a_step_is_refused() {
     let p = write(&dir, "sweep-none.toml", &format!("{}\n[solver]\nsteps = 2\n", base.replace("-20.0]", "-0.5]")));
     let o = stamp(&["run", "-q", "--out", dir.join("out").to_str().unwrap()], &p);
     assert!(o.ok, "{}", o.stderr);
+    let o = stamp(&["check"], &p);
+    assert!(o.ok && !o.stderr.contains("through the plate"), "{}", o.stderr);
 }

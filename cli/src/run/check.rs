@@ -16,6 +16,8 @@
 //!   at the points closest to it (its travel is an unknown: it comes down onto them).
 //!
 //! Warnings (the solve goes on): a punch whose motion or force moves it away from its contact face;
+//! a motion that carries a punch through the plate within an increment of `max_increment`
+//! ([`super::psi_checks::sweep_warning`]);
 //! a punch on the side of the plate away from its contact face; after a run, a punch that never
 //! touched the plate ([`never_touched`]).
 
@@ -359,6 +361,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
         if !wrong_side && push.norm() > 0.0 && push.dot(&n_face) > 1e-9 * push.norm() {
             out.push(format!("{head}: {what} moves it away from its contact face ({face}, outward normal {sign}x3): it will not press the plate"));
         }
+        out.extend(super::psi_checks::sweep_warning(p, setup, i));
     }
     out
 }

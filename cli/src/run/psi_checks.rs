@@ -152,6 +152,37 @@ pub fn check_expression(p: &Problem, setup: &Setup, i: usize, size: f64) -> Resu
     Ok(())
 }
 
+/// For `stamp check`: a warning when the motion of punch `i` carries it through the undeformed
+/// plate within one of the largest increments the solver may take (steps of `max_increment`
+/// towards each target), which the run would then refuse after that step.
+pub fn sweep_warning(p: &Problem, setup: &Setup, i: usize) -> Option<String> {
+    let c = &setup.model.contacts[i];
+    if c.drive.is_some() || c.motion.is_zero() {
+        return None;
+    }
+    let layout = Layout::of(&setup.model.element);
+    let zero = vec![0.0; stamp::nonlinear::NonlinearProblem::num_dofs(&setup.model)];
+    let max_inc = setup.settings.max_increment;
+    let (mut t, mut k) = (0.0f64, 0usize);
+    for &target in &setup.targets {
+        while t != target {
+            let next = if (target - t).abs() <= max_inc { target } else { t + max_inc.copysign(target - t) };
+            k += 1;
+            if let Some(e) = swept_through(p, &setup.mesh, c, i, &layout, k, (t, &zero), (next, &zero)) {
+                let message = match e {
+                    StampError::Input { message, .. } => message,
+                    e => e.to_string(),
+                };
+                // the first line, without the file's place (the warning names the file)
+                let first = message.lines().next().unwrap_or("").to_string();
+                return Some(format!("{}: increments of max_increment = {}: {}; the run stops there", stamp::show_path(&p.path), num(max_inc), first.split_once(": ").map_or(first.as_str(), |x| x.1)));
+            }
+            t = next;
+        }
+    }
+    None
+}
+
 /// The checks after a converged step from load factor `t0` (state `u0`) to `t1` (state `u1`):
 /// an active point without a usable gradient, and a punch carried through the plate between the
 /// two (see the module notes). `step` is the step's number as the outputs count it.
