@@ -16,7 +16,7 @@ pub enum StampError {
     #[error("invalid material or section: {0}")]
     Material(String),
     /// Bad input in a file: names the file and, where known, the line or entity.
-    #[error("{file}: {message}")]
+    #[error("{}: {message}", short_path(file))]
     Input { file: String, message: String },
     /// A boundary condition, load or punch that refers to something that does not exist.
     #[error("invalid problem definition: {0}")]
@@ -46,7 +46,7 @@ pub enum StampError {
         reason: String,
     },
     /// An I/O error with the path it concerns.
-    #[error("{path}: {source}")]
+    #[error("{}: {source}", short_path(path))]
     Io {
         path: String,
         #[source]
@@ -59,6 +59,29 @@ impl StampError {
     pub fn io(path: impl AsRef<std::path::Path>, source: std::io::Error) -> Self {
         StampError::Io { path: path.as_ref().display().to_string(), source }
     }
+}
+
+/// Longest file path that a message shows in full; a longer one keeps its start and its end
+/// (where the file's own name is) around an ellipsis.
+pub const PATH_LIMIT: usize = 120;
+
+/// A file path made fit to show in a message: control characters become `?`, and a path longer
+/// than [`PATH_LIMIT`] characters keeps its first 40 and last 70 characters around
+/// "...(N characters)...".
+pub fn short_path(path: &str) -> String {
+    let clean = |s: String| s.chars().map(|c| if c.is_control() { '?' } else { c }).collect::<String>();
+    let total = path.chars().count();
+    if total <= PATH_LIMIT {
+        return clean(path.to_string());
+    }
+    let head: String = path.chars().take(40).collect();
+    let tail: String = path.chars().skip(total - 70).collect();
+    clean(format!("{head}...({total} characters)...{tail}"))
+}
+
+/// [`short_path`] of a path.
+pub fn show_path(path: &std::path::Path) -> String {
+    short_path(&path.display().to_string())
 }
 
 /// Longest piece of user text (a name, a value, a line of a file) that a message quotes.
@@ -86,6 +109,20 @@ pub fn quote_bytes(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_paths_keep_their_start_and_end() {
+        assert_eq!(short_path("meshes/plate.msh"), "meshes/plate.msh");
+        let long = format!("/home/user/{}/plate.msh", "d".repeat(5000));
+        let s = short_path(&long);
+        assert!(s.chars().count() < 150, "{s}");
+        assert!(s.starts_with("/home/user/ddd") && s.ends_with("ddd/plate.msh") && s.contains("...(5021 characters)..."), "{s}");
+        let e = StampError::Input { file: long.clone(), message: "bad".into() };
+        assert!(e.to_string().chars().count() < 160, "{e}");
+        let e = StampError::io(&long, std::io::Error::other("no"));
+        assert!(e.to_string().ends_with("plate.msh: no"), "{e}");
+        assert_eq!(short_path("a\nb"), "a?b");
+    }
 
     #[test]
     fn quote_cuts_long_text_and_hides_control_bytes() {

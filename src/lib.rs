@@ -15,7 +15,7 @@ pub mod mesh_refine;
 pub mod mesh_transfer;
 pub mod surface;
 
-pub use error::{quote, Result, StampError};
+pub use error::{quote, show_path, short_path, Result, StampError};
 pub mod dofs;
 pub mod element;
 pub mod linalg;

@@ -73,6 +73,25 @@ fn refused(case: &str, text: &str, at: Option<&str>, wanted: &[&str]) -> String 
     err
 }
 
+/// `stamp check` on the problem written by [`refused`] (or any file): (exit code, stderr).
+fn stamp_check(path: &Path) -> (Option<i32>, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(path).output().unwrap();
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// [`refused`] by `stamp run`, and by `stamp check` with the same message.
+fn refused_by_both(case: &str, text: &str, at: Option<&str>, wanted: &[&str]) -> String {
+    let err = refused(case, text, at, wanted);
+    let dir = temp_dir(&format!("badfile-check-{case}"));
+    let path = write(&dir, &format!("{case}.toml"), text);
+    let (code, check_err) = stamp_check(&path);
+    assert_eq!(code, Some(1), "{case}: stamp check: exit code {code:?}, stderr {check_err}");
+    for w in wanted {
+        assert!(check_err.contains(w), "{case}: stamp check: {w:?} not in: {check_err}");
+    }
+    err
+}
+
 fn solver(keys: &str) -> String {
     format!("{BASE}\n[solver]\n{keys}\n")
 }
@@ -93,7 +112,48 @@ fn step_counts_and_rectangle_sizes_out_of_range_are_refused() {
     // extents: finite, increasing, with a finite length, cells distinguishable
     refused("x_huge", &BASE.replace("x = [0.0, 1.0]", "x = [-1e308, 1e308]"), Some("rectangle"), &["mesh.rectangle.x", "magnitude at most 1e100", "[-1e308, 1e308]"]);
     refused("x_backwards", &BASE.replace("x = [0.0, 1.0]", "x = [1.0, 0.0]"), Some("rectangle"), &["mesh.rectangle.x", "increasing"]);
+    // a third number is not dropped
+    refused("x_three", &BASE.replace("x = [0.0, 1.0]", "x = [0.0, 1.0, 30.0]"), Some("rectangle"), &["mesh.rectangle.x", "exactly two numbers", "got 3"]);
+    refused("y_one", &BASE.replace("y = [0.0, 100.0]", "y = [100.0]"), Some("rectangle"), &["mesh.rectangle.y", "exactly two numbers", "got 1"]);
+    refused("n_three", &rect("n = [1, 40, 2]"), Some("rectangle"), &["mesh.rectangle.n", "exactly two numbers", "got 3"]);
     refused("y_tiny_cells", &BASE.replace("y = [0.0, 100.0]", "y = [1e6, 1.0000000000001e6]"), Some("rectangle"), &["mesh.rectangle.y", "too small to tell their nodes apart"]);
+}
+
+#[test]
+fn a_plot_group_the_mesh_lacks_is_refused_by_check_as_by_run() {
+    refused_by_both("plot_group", &format!("{BASE}\n[output]\nplot_group = \"nosuch\"\n"), Some("plot_group"), &["output.plot_group", "no group named 'nosuch'"]);
+    // arc needs a curve: the surface 'all' is not one
+    refused_by_both("plot_group_arc", &format!("{BASE}\n[output]\nplot_axis = \"arc\"\nplot_group = \"all\"\n"), Some("plot_group"), &["output.plot_group", "no curve group named 'all'"]);
+}
+
+#[test]
+fn a_number_with_a_unit_is_told_that_units_are_labels() {
+    for (case, from, to, shown) in [
+        ("unit_E", "E = 2.0e4", "E = 210 GPa", "'210 GPa'"),
+        ("unit_glued", "E = 2.0e4", "E = 2e4MPa", "'2e4 MPa'"),
+        ("unit_thickness", "thickness = 2.0", "thickness = 2 mm", "'2 mm'"),
+        ("unit_in_array", "force = [0.0, 0.0, 0.05]", "force = [0.0, 0.0, 0.05 N/mm]", "'0.05 N/mm'"),
+    ] {
+        let e = refused(case, &BASE.replace(from, to), Some(to), &[shown, "number followed by a unit", "[units]"]);
+        assert!(!e.contains("must be quoted"), "{case}: {e}");
+    }
+    // a word that is no number keeps toml's message
+    refused("bare_word", &BASE.replace("E = 2.0e4", "E = steel"), Some("E = steel"), &["plate.E"]);
+}
+
+#[test]
+fn a_punch_that_starts_between_the_faces_is_refused() {
+    // thickness 2000 where 2 was meant: the roller (z from 1 to 9) sits inside the plate
+    let text = format!("{}{PUNCH}", BASE.replace("thickness = 2.0", "thickness = 2000"));
+    refused_by_both("buried", &text, Some("[[punch]]"), &["punch[0]", "'roller' starts inside the plate's volume", "between the faces x3 = -1000 and 1000", "plate.thickness"]);
+    // a ball in the lower half of the thick plate
+    let ball = PUNCH.replace("shape = \"cylinder\"\npoint = [0.0, 50.0, 5.0]\naxis = [1.0, 0.0, 0.0]\nradius = 4.0", "shape = \"sphere\"\ncenter = [0.5, 50.0, -500.0]\nradius = 10.0");
+    let text = format!("{}{ball}", BASE.replace("thickness = 2.0", "thickness = 2000"));
+    refused_by_both("buried_ball", &text, Some("[[punch]]"), &["punch[0]", "starts inside the plate's volume", "x3 = -490"]);
+    // the thickness meant: no error
+    let dir = temp_dir("badfile-buried-ok");
+    let (code, err) = stamp_check(&write(&dir, "ok.toml", &format!("{BASE}{PUNCH}")));
+    assert_eq!(code, Some(0), "{err}");
 }
 
 #[test]
@@ -155,6 +215,34 @@ fn user_strings_are_bounded_and_vectors_show_tiny_values() {
     refused("zero_axis", &text, Some("axis ="), &["punch[0].axis", "non-zero"]);
     // an unknown constraint word of any length
     refused("long_word", &BASE.replace("\"clamped\"", &format!("\"{}\"", "w".repeat(5000))), Some("fix ="), &["boundary[0].fix", "unknown displacement", "(5000 characters)"]);
+}
+
+#[test]
+fn long_file_names_are_shortened_in_messages() {
+    // a mesh or STL file key of 5000 characters: the message keeps the path's start and end
+    let mesh = format!("{}.msh", "m".repeat(5000));
+    let e = refused("long_mesh", &BASE.replace("rectangle = { x = [0.0, 1.0], y = [0.0, 100.0], n = [1, 40] }", &format!("file = \"{mesh}\"")), Some("file ="), &["mesh.file", "does not exist", "characters)...mmm", "mmm.msh"]);
+    assert!(e.chars().count() < 480, "{e}");
+    let stl = format!("{}.stl", "s".repeat(5000));
+    let text = format!("{BASE}{}", PUNCH.replace("shape = \"cylinder\"\npoint = [0.0, 50.0, 5.0]\naxis = [1.0, 0.0, 0.0]\nradius = 4.0\n", &format!("shape = \"stl\"\nfile = \"{stl}\"\n")));
+    let e = refused("long_stl", &text, Some("file ="), &["punch[0].file", "sss.stl"]);
+    assert!(e.chars().count() < 480, "{e}");
+    // a problem file 2000 characters deep (folders of 200): the message names it short, and the
+    // warnings of stamp check too
+    let mut dir = temp_dir("badfile-deep");
+    for _ in 0..10 {
+        dir = dir.join("d".repeat(200));
+    }
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = write(&dir, "deep.toml", &BASE.replace("E = 2.0e4", "E = -1.0"));
+    let (code, err) = stamp_run(&path, &dir.join("out"), Duration::from_secs(20));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("dd/deep.toml: line 7") && err.contains("characters)...") && err.chars().count() < 480, "{err}");
+    let away = format!("{BASE}{}", PUNCH.replace("motion = [0.0, 0.0, -1.0]", "motion = [0.0, 0.0, 1.0]"));
+    let path = write(&dir, "away.toml", &away);
+    let (code, err) = stamp_check(&path);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("dd/away.toml: punch[0]") && err.contains("moves it away") && err.chars().count() < 480, "{err}");
 }
 
 #[test]

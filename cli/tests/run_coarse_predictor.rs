@@ -101,7 +101,12 @@ fn refine_starts_every_finer_mesh_from_the_one_before() {
 /// `stamp run` and `stamp check` refuse `text` (written as `case`.toml beside the shipped meshes)
 /// naming the file, "line L" of the first line that starts with `at`, and every one of `wanted`.
 fn refused(case: &str, shipped: &str, edits: &[(&str, &str)], at: &str, wanted: &[&str]) {
-    let path = variant(case, shipped, edits);
+    refused_at(&variant(case, shipped, edits), case, at, wanted);
+}
+
+/// [`refused`] for a problem file written already.
+fn refused_at(path: &std::path::Path, case: &str, at: &str, wanted: &[&str]) {
+    let path = path.to_path_buf();
     let text = std::fs::read_to_string(&path).unwrap();
     let line = text.lines().position(|l| l.trim_start().starts_with(at)).unwrap_or_else(|| panic!("no line starts with {at} in {case}")) + 1;
     let (code, err) = stamp_run(&path, &path.with_extension("out"), &[]);
@@ -133,9 +138,25 @@ fn bad_combinations_are_refused_with_the_key_and_the_line() {
     refused("no-coarse-file", "disk-clamped.toml", &[gmsh], "predictor", &["solver.predictor", "coarse_file"]);
     refused("coarse-file-alone", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"disk-clamped.msh\"")], "coarse_file", &["mesh.coarse_file", "predictor = \"coarse\""]);
     refused("coarse-file-missing", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"nothere.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "nothere.msh", "does not exist"]);
-    refused("coarse-file-groups", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"sphere-ss-full.msh\""), gmsh], "group = \"left\"", &["coarse mesh sphere-ss-full.msh", "boundary[0].group", "'left'"]);
+    // (the disk meshed coarser, its group 'left' named 'side')
+    let path = variant("coarse-file-groups", "disk-clamped.toml", &[(file, "file = \"disk-clamped-lc1.msh\"\ncoarse_file = \"renamed.msh\""), gmsh]);
+    let disk = std::fs::read_to_string(repo().join("meshes/disk-clamped.msh")).unwrap();
+    write(path.parent().unwrap(), "renamed.msh", &disk.replacen("1 2 \"left\"", "1 2 \"side\"", 1));
+    refused_at(&path, "coarse-file-groups", "group = \"left\"", &["coarse mesh renamed.msh", "boundary[0].group", "'left'"]);
+    // a mesh of another plate with other groups: refused as another plate first
+    refused("coarse-file-square", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"sphere-ss-full.msh\""), gmsh], "coarse_file", &["coarse mesh sphere-ss-full.msh", "not the same plate", "(-20, -20)"]);
     // a mesh of another plate (the paper's strip, 1 x 100): the disk's node at (20, 0) is 19 away
     refused("coarse-file-elsewhere", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"paper-r100.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "does not cover the plate", "gmsh node", "(20, 0)", "19 outside"]);
+    // a larger plate (the coarse disk scaled by 2, the same groups) covers the plate: refused
+    // the other way round, its node at (20 cos 45, 20 sin 45) x 2 lies 20 outside the disk
+    let path = variant("coarse-file-larger", "disk-clamped.toml", &[(file, "file = \"disk-clamped-lc1.msh\"\ncoarse_file = \"big.msh\""), gmsh]);
+    write(path.parent().unwrap(), "big.msh", &scaled_msh(&std::fs::read_to_string(repo().join("meshes/disk-clamped.msh")).unwrap(), 2.0));
+    refused_at(&path, "coarse-file-larger", "coarse_file", &["mesh.coarse_file", "not the same plate", "(28.284271, 28.284271)", "20.01", "outside the mesh"]);
+    // a smaller one, scaled by 0.5 (the disk's nodes outside it) and one squeezed along x2 by a
+    // few per cent (every node within a fifth of a cell both ways: its area tells)
+    let path = variant("coarse-file-smaller", "disk-clamped.toml", &[(file, "file = \"disk-clamped-lc1.msh\"\ncoarse_file = \"small.msh\""), gmsh]);
+    write(path.parent().unwrap(), "small.msh", &scaled_msh(&std::fs::read_to_string(repo().join("meshes/disk-clamped.msh")).unwrap(), 0.5));
+    refused_at(&path, "coarse-file-smaller", "coarse_file", &["mesh.coarse_file", "does not cover the plate"]);
     // an unreadable coarse file: the reader's message names it, and says which key of which
     // problem file asked for it
     let path = variant("coarse-file-msh22", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"old.msh\""), gmsh]);
@@ -144,4 +165,26 @@ fn bad_combinations_are_refused_with_the_key_and_the_line() {
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("old.msh: MSH format version 2.2") && err.contains("read as mesh.coarse_file of") && err.contains("coarse-file-msh22.toml"), "{err}");
     refused("coarse-file-finer", "disk-clamped.toml", &[(file, "file = \"disk-clamped.msh\"\ncoarse_file = \"disk-clamped-lc1.msh\""), gmsh], "coarse_file", &["mesh.coarse_file", "2359 nodes", "fewer"]);
+}
+
+/// An ASCII MSH 4.1 text with every node's coordinates times `factor` (the lines of three numbers
+/// in $Nodes).
+fn scaled_msh(text: &str, factor: f64) -> String {
+    let mut inside = false;
+    let mut out = String::new();
+    for line in text.lines() {
+        match line {
+            "$Nodes" => inside = true,
+            "$EndNodes" => inside = false,
+            _ => {}
+        }
+        let words: Vec<&str> = line.split_whitespace().collect();
+        if inside && words.len() == 3 {
+            out += &words.iter().map(|w| (w.parse::<f64>().unwrap() * factor).to_string()).collect::<Vec<_>>().join(" ");
+        } else {
+            out += line;
+        }
+        out.push('\n');
+    }
+    out
 }

@@ -186,3 +186,71 @@ fn bad_paths_are_refused_with_the_row() {
     let e = bad("path-two", "[0.0, -0.05]");
     assert!(e.contains("got 2 numbers"), "{e}");
 }
+
+/// `stamp run` and `stamp check` on the ellipsoid problem with `psi` replaced and the punch moved
+/// 0.5 into the plate: both refuse, with `wanted` in the message.
+fn psi_refused(name: &str, psi_text: &str, wanted: &[&str]) {
+    let ellipsoid = "psi = \"(x1 / 120)^2 + (x2 / 80)^2 + ((x3 - 40.5) / 40)^2 - 1\"";
+    let p = variant(name, "ellipsoid-expression.toml", &[(ellipsoid, &format!("psi = \"{psi_text}\"")), ("force = 4000.0", "motion = [0.0, 0.0, -0.5]")]);
+    let line = std::fs::read_to_string(&p).unwrap().lines().position(|l| l.starts_with("psi = ")).unwrap() + 1;
+    let dir = temp_dir(&format!("{name}-out"));
+    for o in [stamp(&["check"], &p), stamp(&["run", "-q", "--out", dir.to_str().unwrap()], &p)] {
+        assert!(!o.ok, "{psi_text} was accepted: {}", o.stderr);
+        assert!(o.stderr.contains(&format!("{name}.toml: line {line}, column 7: punch[0].psi: 'ellipsoid'")), "{}", o.stderr);
+        for w in wanted {
+            assert!(o.stderr.contains(w), "{w:?} not in {}", o.stderr);
+        }
+    }
+}
+
+#[test]
+fn a_psi_without_a_usable_gradient_is_refused_before_the_solve() {
+    // the ellipsoid scaled by 1e-170: Psi and its gradient are tiny, the gradient's square
+    // underflows (the run "converged" with force 0)
+    psi_refused("psi-tiny", "1e-170 * ((x1 / 120)^2 + (x2 / 80)^2 + ((x3 - 40.5) / 40)^2 - 1)", &["no surface near the plate", "underflows"]);
+    // constants: no surface at all
+    psi_refused("psi-minus-one", "-1", &["no surface near the plate", "|grad Psi| = 0"]);
+    psi_refused("psi-zero", "0", &["no surface near the plate", "|grad Psi| = 0"]);
+    psi_refused("psi-one", "1", &["no surface near the plate"]);
+    // a surface far beyond the model: 1e-20 x3 + 1 is zero at x3 = -1e20
+    psi_refused("psi-far", "1 + 1e-20 * x3", &["model sizes away"]);
+    // a Psi flat (zero) over half the plate, which it covers: usable elsewhere, refused there
+    psi_refused("psi-flat", "min(x3 - 0.5 + 0.01 * x1, 0 * x1)", &["covers the node at", "|grad Psi| = 0", "no force"]);
+}
+
+#[test]
+fn a_path_that_carries_the_punch_through_the_plate_within_a_step_is_refused() {
+    // a roller 1 above a strip (thickness 2) goes 20 down and back up by load factor 1
+    let base = CANTILEVER.to_string()
+        + "\n[[punch]]\nname = \"roller\"\nshape = \"cylinder\"\npoint = [0.0, 50.0, 5.0]\naxis = [1.0, 0.0, 0.0]\nradius = 4.0\nmotion = [[0.5, 0.0, 0.0, -20.0], [1.0, 0.0, 0.0, 0.0]]\n";
+    for (case, solver, wanted) in [
+        ("sweep-one-step", "steps = 1\nmax_increment = 1.0", "step 1 from load factor 0 to 1: the motion carries 'roller' through the plate"),
+        ("sweep-increments", "steps = 1", "step 1 from load factor 0 to 0.25: the motion carries 'roller' through the plate"),
+    ] {
+        let dir = temp_dir(case);
+        let p = write(&dir, &format!("{case}.toml"), &format!("{base}\n[solver]\n{solver}\n"));
+        // stamp check foresees it (a warning: the solver's increments may be smaller)
+        let o = stamp(&["check"], &p);
+        assert!(o.ok && o.stderr.contains(&format!("warning: {}: increments of max_increment", p.display())) && o.stderr.contains("carries 'roller' through the plate"), "{case}: {}", o.stderr);
+        let out = dir.join("out");
+        let o = stamp(&["run", "-q", "--out", out.to_str().unwrap()], &p);
+        assert!(!o.ok, "{case}: the run passed");
+        assert!(o.stderr.contains(&format!("{case}.toml: line 21, column 1: punch[0].motion: {wanted}")), "{case}: {}", o.stderr);
+        assert!(o.stderr.contains("use more steps: [solver] max_increment at most 0.025"), "{case}: {}", o.stderr);
+        let s = summary(&out);
+        assert_eq!(s["status"], "failed", "{s}");
+        assert!(s["steps"].as_array().unwrap().iter().all(|e| e["converged"] != true), "no step is listed as converged: {s}");
+    }
+    // the path row in the step is named
+    let dir = temp_dir("sweep-row");
+    let p = write(&dir, "sweep-row.toml", &format!("{base}\n[solver]\nsteps = 1\nmax_increment = 1.0\n"));
+    let o = stamp(&["run", "-q", "--out", dir.join("out").to_str().unwrap()], &p);
+    assert!(o.stderr.contains("(the path's row at t = 0.5 lies inside the step)"), "{}", o.stderr);
+    // down by 1 and back (into the plate, not through it): no complaint
+    let dir = temp_dir("sweep-none");
+    let p = write(&dir, "sweep-none.toml", &format!("{}\n[solver]\nsteps = 2\n", base.replace("-20.0]", "-0.5]")));
+    let o = stamp(&["run", "-q", "--out", dir.join("out").to_str().unwrap()], &p);
+    assert!(o.ok, "{}", o.stderr);
+    let o = stamp(&["check"], &p);
+    assert!(o.ok && !o.stderr.contains("through the plate"), "{}", o.stderr);
+}

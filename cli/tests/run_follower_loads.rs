@@ -105,6 +105,11 @@ fn bad_moment_and_follower_keys_name_the_key_and_line() {
     // a twist about the normal cannot be carried by a fixed couple
     let e = error_of("twist", &roll.replace("\nfollower = true\n", "\nfollower = false\n").replace("0.06283185307179587, 0.0]", "0.06283185307179587, 0.5]"));
     assert!(e.contains("load[0].moment") && e.contains("m3 must be 0") && line(&e), "{e}");
+    // ... nor by a follower one: about the normal only, the whole load would be dropped
+    let e = error_of("twist_follower", &roll.replace("[0.0, -0.06283185307179587, 0.0]", "[0.0, 0.0, 0.5]"));
+    assert!(e.contains("load[0].moment") && e.contains("follower couple") && e.contains("m3 must be 0") && e.contains("whole load") && line(&e), "{e}");
+    let e = error_of("twist_follower_mixed", &roll.replace("0.06283185307179587, 0.0]", "0.06283185307179587, 0.5]"));
+    assert!(e.contains("load[0].moment") && e.contains("m3 must be 0, got 0.5") && !e.contains("whole load"), "{e}");
     // no moment vector
     let e = error_of("no_moment", &roll.replace("moment = [", "#moment = ["));
     assert!(e.contains("load[0]") && e.contains("needs `moment`"), "{e}");

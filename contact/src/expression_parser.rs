@@ -353,4 +353,60 @@ mod tests {
         let minus = "-".repeat(1500) + "1";
         assert!(col(&minus).1.contains("nests deeper"));
     }
+
+    /// xorshift64*: the same inputs on every run.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+        fn below(&mut self, n: usize) -> usize {
+            (self.next() % n.max(1) as u64) as usize
+        }
+    }
+
+    #[test]
+    fn hundreds_of_random_and_mutated_expressions_give_a_tree_or_an_error_never_a_panic() {
+        let mut rng = Rng(0x5eed_0031);
+        let seeds = ["(x1 / 120)^2 + (x2 / 80)^2 + ((x3 - 40.5) / 40)^2 - 1", "sqrt(x1^2 + x2^2) - hypot(x3, 2) * atan2(x1, -x2)", "min(max(x1, x2), exp(-ln(abs(x3) + 1e-3))) ** 2 - pi * e"];
+        let pieces = ["(", ")", "+", "-", "*", "/", "^", "**", ",", "x1", "x2", "x3", "x4", "1e308", "1e-320", "0", ".", "e", "pi", "sqrt", "atan2", "min(", " ", "µ", "\u{0}", "1e", "nan", "inf"];
+        let (mut ok, mut err) = (0, 0);
+        for k in 0..800 {
+            let text: String = if k % 4 == 3 {
+                (0..rng.below(40)).map(|_| pieces[rng.below(pieces.len())]).collect()
+            } else {
+                let mut c: Vec<char> = seeds[k % 3].chars().collect();
+                for _ in 0..1 + rng.below(4) {
+                    let at = rng.below(c.len() + 1);
+                    match rng.below(3) {
+                        0 if at < c.len() => {
+                            c.remove(at);
+                        }
+                        1 => c.splice(at..at, pieces[rng.below(pieces.len())].chars()).for_each(drop),
+                        _ => c.truncate(at),
+                    }
+                }
+                c.into_iter().collect()
+            };
+            match parse(&text) {
+                Ok(_) => {
+                    ok += 1;
+                    // and it evaluates (finite or not) without a panic
+                    let e = crate::Expression::new(&text, 1.0).unwrap();
+                    for x in [[0.0, 0.0, 0.0], [1.0, -2.0, 3.5], [1e300, -1e-300, 0.5]] {
+                        let _ = e.jet(&nalgebra::Vector3::from(x));
+                    }
+                }
+                Err(e) => {
+                    err += 1;
+                    assert!(e.column >= 1 && e.column <= text.chars().count() + 1, "column {} of {text:?}", e.column);
+                    assert!(!e.message.is_empty() && e.message.len() < 400, "{}", e.message);
+                }
+            }
+        }
+        assert!(ok >= 20 && err >= 100, "{ok} parsed, {err} refused");
+    }
 }

@@ -41,6 +41,22 @@ fn ascii_and_binary_read_the_same_welded_mesh() {
 }
 
 #[test]
+fn every_solid_of_an_ascii_file_is_read() {
+    let d = temp_dir("solids");
+    let t = tetrahedron();
+    let moved: Vec<_> = t.iter().map(|f| f.map(|v| [v[0] + 5.0, v[1], v[2]])).collect();
+    // two solids, the second named on its lines, blank lines between and after
+    let text = format!("{}\n{}\n\n", ascii_stl(&t), ascii_stl(&moved).replace("solid test", "solid part two"));
+    write(&d.join("two.stl"), text.as_bytes());
+    let m = read_stl(&d.join("two.stl"), 1000).unwrap();
+    assert_eq!((m.vertices.len(), m.facets.len()), (8, 8));
+    assert!(m.vertices.iter().any(|v| v[0] == 6.0), "the second solid's vertices are there");
+    // the facet limit counts both
+    let e = read_stl(&d.join("two.stl"), 6).unwrap_err().to_string();
+    assert!(e.contains("too many facets"), "{e}");
+}
+
+#[test]
 fn every_bad_file_is_refused_naming_the_file_and_the_facet() {
     let d = temp_dir("errors");
     let t = tetrahedron();
@@ -100,6 +116,21 @@ fn every_bad_file_is_refused_naming_the_file_and_the_facet() {
     write(&d.join("nend.stl"), text.replace("endsolid test\n", "").as_bytes());
     let e = error_of(&d.join("nend.stl"));
     assert!(e.contains("after 4 facets without `endsolid`"), "{e}");
+    // after `endsolid`: a garbage line is refused with its line, not ignored
+    write(&d.join("tail.stl"), format!("{text}garbage here\n").as_bytes());
+    let e = error_of(&d.join("tail.stl"));
+    let line = text.lines().count() + 1;
+    assert!(e.contains("tail.stl") && e.contains(&format!("line {line}:")) && e.contains("after `endsolid`") && e.contains("'garbage'"), "{e}");
+    // ... and so is a word between `solid` and the first facet
+    write(&d.join("head.stl"), text.replacen("solid test\n", "solid test\njunk\n", 1).as_bytes());
+    let e = error_of(&d.join("head.stl"));
+    assert!(e.contains("line 2:") && e.contains("'junk'"), "{e}");
+    // a second solid with garbage after it: refused at the garbage's line
+    let moved: Vec<_> = t.iter().map(|f| f.map(|v| [v[0] + 5.0, v[1], v[2]])).collect();
+    let two = format!("{text}{}", ascii_stl(&moved));
+    write(&d.join("two-tail.stl"), format!("{two}\n  endsolid\n").as_bytes());
+    let e = error_of(&d.join("two-tail.stl"));
+    assert!(e.contains(&format!("line {}:", two.lines().count() + 2)) && e.contains("after `endsolid` of solid 2"), "{e}");
     write(&d.join("empty.stl"), b"solid x\nendsolid x\n");
     assert!(error_of(&d.join("empty.stl")).contains("no facets"));
     write(&d.join("short.stl"), b"hello");

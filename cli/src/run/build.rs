@@ -200,6 +200,30 @@ fn build_coarse(p: &Problem, fine: &MeshData) -> Result<CoarseSetup> {
             ),
         ));
     }
+    // ... and the other way round: no node of the coarse mesh farther outside the mesh (a coarse
+    // mesh of a larger plate covers the plate and more), and the same area
+    let (node, distance) = stamp::mesh_transfer::Prolongation::between(&fine.mesh, &coarse.mesh).farthest_outside();
+    if distance > allowed {
+        return Err(p.error_at(
+            span,
+            span_key,
+            format!(
+                "{what} is not the same plate: {} of the coarse mesh lies {} outside the mesh (at most {} allowed, a fifth of its mean cell size); the coarse mesh must mesh the same plate",
+                super::mesh::where_node(&coarse, node),
+                num(distance),
+                num(allowed)
+            ),
+        ));
+    }
+    let area = |m: &MeshData| m.mesh.nodal_areas().iter().sum::<f64>();
+    let (a_coarse, a_fine) = (area(&coarse), area(fine));
+    if (a_coarse - a_fine).abs() > 0.05 * a_fine {
+        return Err(p.error_at(
+            span,
+            span_key,
+            format!("{what} is not the same plate: its area is {}, the mesh's {} (they may differ by at most 5%)", num(a_coarse), num(a_fine)),
+        ));
+    }
     // a mesh error of the coarse file names the coarse file (mesh_error names `mesh.file`)
     let fine_file = p.spec.mesh.get_ref().file.as_ref().map(|f| p.dir().join(f.get_ref()).display().to_string());
     let coarse_file = p.spec.mesh.get_ref().coarse_file.as_ref().map(|f| p.dir().join(f.get_ref()).display().to_string());

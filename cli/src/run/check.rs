@@ -5,7 +5,10 @@
 //! * a support, load or punch on a group with nothing in it (no nodes; a line load on a curve with
 //!   no edges; a pressure or surface load on a surface with no cells);
 //! * a punch that starts inside the plate by more than its penetration tolerance
-//!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness);
+//!   (`penetration_tolerance`, default [`DEFAULT_PENETRATION`] times the thickness), at its
+//!   contact face or anywhere between the faces (the plate's volume);
+//! * an expression punch without a usable gradient of Psi along its motion
+//!   ([`super::psi_checks`]);
 //! * rigid-body motions held by nothing (see [`super::rigid_modes`]): the rows are the supports'
 //!   held components (fixed and prescribed dofs, plane strain) at their faces, and the line x3 at
 //!   the points where a punch touches the plate at the start (gap <= [`TOUCH`] times the model
@@ -19,12 +22,14 @@
 //!   move away together).
 //!
 //! Warnings (the solve goes on): a punch whose motion or force moves it away from its contact face;
+//! a motion that carries a punch through the plate within an increment of `max_increment`
+//! ([`super::psi_checks::sweep_warning`]);
 //! a punch on the side of the plate away from its contact face; after a run, a punch that never
 //! touched the plate or touched it on a zone narrower than the cells ([`after_the_run`]).
 
 use super::build::Setup;
 use super::mesh::{where_node, MeshData};
-use super::problem::{LoadFace, LoadKind, Problem};
+use super::problem::{LoadFace, LoadKind, PlotAxis, Problem};
 use super::punch_start::{first_gap, gap_at, start_gaps, PointGap};
 use super::rigid_modes::{direction_words, join_and, num, RigidModes};
 use super::travel_modes::TravelModes;
@@ -68,6 +73,7 @@ pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
     let size = model_size(setup);
     let mut starts = Vec::new();
     for i in 0..setup.punches.len() {
+        super::psi_checks::check_expression(p, setup, i, size)?;
         starts.push(punch_start(p, setup, i, size)?);
     }
     let rigid = check_rigid_modes(p, setup, &starts, size)?;
@@ -145,6 +151,15 @@ fn check_groups(p: &Problem, mesh: &MeshData) -> Result<()> {
             }
         }
     }
+    // the plot group as the run reads it (a curve for plot_axis = "arc", any group else)
+    if let Some(g) = &s.output.plot_group {
+        let name = g.get_ref();
+        let found = if s.output.plot_axis == PlotAxis::Arc { mesh.curve_chain(name).is_some() } else { mesh.nodes(name).is_some() };
+        if !found {
+            let kind = if s.output.plot_axis == PlotAxis::Arc { "curve" } else { "" };
+            return Err(super::mesh::group_error(p, g.span(), "output.plot_group", name, kind, mesh));
+        }
+    }
     Ok(())
 }
 
@@ -181,6 +196,7 @@ fn punch_start(p: &Problem, setup: &Setup, i: usize, size: f64) -> Result<PunchS
             ));
         }
     }
+    inside_volume(p, setup, i, &gaps, tol)?;
     let touch = (TOUCH * size).max(p.spec.punch[i].get_ref().penetration_tolerance.as_ref().map(|t| t.get_ref().0).unwrap_or(0.0));
     let mut holding: Vec<PointGap> = gaps.iter().filter(|g| g.gap <= touch).copied().collect();
     let touching = !holding.is_empty();
@@ -190,6 +206,41 @@ fn punch_start(p: &Problem, setup: &Setup, i: usize, size: f64) -> Result<PunchS
         }
     }
     Ok(PunchStart { key, name: info.name.clone(), first, holding, touching })
+}
+
+/// Err when punch `i` starts inside the plate's volume, between its faces (deeper than the
+/// penetration tolerance `tol` from either face): where the flow from a candidate point meets the
+/// punch's surface, or a point of the mid-plane under a candidate point inside the punch. The
+/// face check above cannot see it (`thickness = 2000` where 2 was meant: the punch sits between
+/// the faces, away from both).
+fn inside_volume(p: &Problem, setup: &Setup, i: usize, gaps: &[PointGap], tol: f64) -> Result<()> {
+    let (dm, dp) = (setup.section.delta_minus, setup.section.delta_plus);
+    let pair = &setup.model.contacts[i];
+    let info = &setup.punches[i];
+    let between = |z: f64| z > dm + tol && z < dp - tol;
+    let mid = 0.5 * (dm + dp);
+    let found = gaps.iter().find_map(|g| g.foot.filter(|f| between(f[2])).map(|f| (g.node, f[2], "its surface passes")));
+    let found = found.or_else(|| {
+        gaps.iter().find_map(|g| {
+            let x = Vector3::new(g.x[0], g.x[1], mid);
+            let (psi, grad) = (pair.surface.psi(&x), pair.surface.gradient(&x).norm());
+            (psi < 0.0 && psi.is_finite() && grad.is_finite() && psi < -tol * grad).then_some((g.node, mid, "the mid-plane is inside it"))
+        })
+    });
+    let Some((node, z, what)) = found else { return Ok(()) };
+    Err(p.error_at(
+        p.spec.punch[i].span(),
+        &format!("punch[{i}]"),
+        format!(
+            "'{}' starts inside the plate's volume: {what} at x3 = {}, on the fibre of {}, between the faces x3 = {} and {} (thickness {}); is plate.thickness right, or the punch's position?",
+            quote(&info.name),
+            num(z),
+            where_node(&setup.mesh, node),
+            num(dm),
+            num(dp),
+            num(dp - dm)
+        ),
+    ))
 }
 
 fn face_word(f: Face) -> &'static str {
@@ -311,7 +362,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
     let mut out = Vec::new();
     let h = setup.section.thickness();
     for (i, (info, pair)) in setup.punches.iter().zip(&setup.model.contacts).enumerate() {
-        let head = format!("{}: punch[{i}] ('{}')", file(p), quote(&info.name));
+        let head = format!("{}: punch[{i}] ('{}')", stamp::show_path(&p.path), quote(&info.name));
         let n_face = face_normal(info.face);
         let face = face_word(info.face);
         let sign = if info.face == Face::Top { "+" } else { "-" };
@@ -348,6 +399,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
         if !wrong_side && push.norm() > 0.0 && push.dot(&n_face) > 1e-9 * push.norm() {
             out.push(format!("{head}: {what} moves it away from its contact face ({face}, outward normal {sign}x3): it will not press the plate"));
         }
+        out.extend(super::psi_checks::sweep_warning(p, setup, i));
     }
     out
 }
@@ -380,7 +432,7 @@ pub fn after_the_run(p: &Problem, summary: &Path) -> Vec<String> {
         if counts.len() == converged.len() && counts.iter().all(|&c| c == 0) {
             out.push(format!(
                 "{}: punch[{i}] ('{}') never touched the plate: no node was in contact at any of the {} recorded steps; check its position, motion and face",
-                file(p),
+                stamp::show_path(&p.path),
                 quote(&name),
                 converged.len()
             ));

@@ -67,11 +67,11 @@ impl MeshData {
     fn read(p: &Problem, file: &Spanned<String>, key: &str) -> Result<MeshData> {
         let path = p.dir().join(file.get_ref());
         if !path.exists() {
-            return Err(p.error_at(file.span(), key, format!("{} does not exist", path.display())));
+            return Err(p.error_at(file.span(), key, format!("{} does not exist", stamp::show_path(&path))));
         }
         // the reader names the .msh file; the problem file and its key say where it was asked for
         let g = read_msh(&path).map_err(|e| match e {
-            StampError::Input { file, message } => StampError::Input { file, message: format!("{message} (read as {key} of {})", p.path.display()) },
+            StampError::Input { file, message } => StampError::Input { file, message: format!("{message} (read as {key} of {})", stamp::show_path(&p.path)) },
             e => e,
         })?;
         let surfaces = g.mesh.cell_groups.clone();

@@ -26,6 +26,7 @@ pub mod output;
 pub mod plate_model;
 pub mod plot;
 pub mod probe;
+pub mod psi_checks;
 pub mod problem;
 pub mod punch_start;
 pub mod refine;

@@ -191,7 +191,7 @@ fn remove_refined_runs(dir: &Path) -> Result<Vec<String>> {
 impl Drop for RunFolder {
     fn drop(&mut self) {
         if let Err(e) = self.finish() {
-            eprintln!("warning: cannot record the files of this run in {}: {e}", self.dir.join(MANIFEST).display());
+            eprintln!("warning: cannot record the files of this run in {}: {e}", stamp::show_path(&self.dir.join(MANIFEST)));
         }
     }
 }

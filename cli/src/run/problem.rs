@@ -399,9 +399,17 @@ pub struct RectangleSpec {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawRectangle {
-    x: [f64; 2],
-    y: [f64; 2],
-    n: [AnyNumber; 2],
+    // read as lists: serde's [f64; 2] takes the first two numbers of a longer array and drops the
+    // rest without a word
+    x: Vec<f64>,
+    y: Vec<f64>,
+    n: Vec<AnyNumber>,
+}
+
+/// Exactly two entries of `key`, else what is wrong.
+fn exactly_two<T>(key: &str, what: &str, v: Vec<T>) -> std::result::Result<[T; 2], String> {
+    let len = v.len();
+    <[T; 2]>::try_from(v).map_err(|_| format!("mesh.rectangle.{key}: expected exactly two numbers {what}, got {len}"))
 }
 
 impl RectangleSpec {
@@ -436,8 +444,11 @@ impl RectangleSpec {
 impl<'de> Deserialize<'de> for RectangleSpec {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let r = RawRectangle::deserialize(d)?;
-        let n = RectangleSpec::check(r.x, r.y, r.n).map_err(D::Error::custom)?;
-        Ok(RectangleSpec { x: r.x, y: r.y, n })
+        let x = exactly_two("x", "[x_min, x_max]", r.x).map_err(D::Error::custom)?;
+        let y = exactly_two("y", "[y_min, y_max]", r.y).map_err(D::Error::custom)?;
+        let n = exactly_two("n", "[cells along x, cells along y]", r.n).map_err(D::Error::custom)?;
+        let n = RectangleSpec::check(x, y, n).map_err(D::Error::custom)?;
+        Ok(RectangleSpec { x, y, n })
     }
 }
 
@@ -791,12 +802,37 @@ fn toml_message(source: &str, e: &toml::de::Error) -> String {
     let what = quote_long(&what.join(" "), 300);
     let Some(span) = e.span() else { return what };
     let (line, col) = line_col_of(source, span.start);
+    // `E = 210 GPa`: toml asks for quotes, but the value is meant as a number
+    // (toml may point inside the value, at the unit of `2e4MPa`: back to the value's start)
+    let before = source.get(..span.start).unwrap_or("");
+    let value_start = before.trim_end_matches(|c: char| c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | '_' | 'e' | 'E')).len();
+    let what = match number_with_unit(source.get(value_start..).unwrap_or("")) {
+        Some((number, unit)) => format!(
+            "'{}' is a number followed by a unit: values are plain numbers in the file's own consistent units (write {}); unit names are labels, given once in [units] (length, force, pressure)",
+            quote(&format!("{number} {unit}")),
+            quote(number)
+        ),
+        None => what,
+    };
     let what = match key_at(source, line, col) {
         // our own checks may name the key already ("mesh.rectangle.n: ...")
         Some(key) if !what.starts_with(&key) => format!("{}: {what}", quote(&key)),
         _ => what,
     };
     format!("line {line}, column {col}: {what}\n{}", source_window(source, line, col))
+}
+
+/// A value written as a number followed by a unit word (`210 GPa`, `2mm`, `0.05 N/mm`): the
+/// number and the unit, else None. `text` starts at the value.
+fn number_with_unit(text: &str) -> Option<(&str, &str)> {
+    let line = text.lines().next()?;
+    let end = line.find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | '_' | 'e' | 'E'))).unwrap_or(line.len());
+    // the longest prefix that is a number ("2e4MPa": "2e4"; "5em": "5")
+    let (number, rest) = (1..=end).rev().map(|k| line.split_at(k)).find(|(n, _)| n.replace('_', "").parse::<f64>().is_ok())?;
+    let rest = rest.trim_start();
+    let unit_end = rest.find(|c: char| c.is_whitespace() || matches!(c, ',' | ']' | '}' | '#')).unwrap_or(rest.len());
+    let unit = &rest[..unit_end];
+    unit.chars().next().is_some_and(|c| c.is_alphabetic() || c == '%').then_some((number, unit))
 }
 
 /// "  L | <the line around the column>": the problem file's line under an error (at most 60
@@ -1015,11 +1051,15 @@ impl Problem {
                     if ls.force.is_some() || ls.pressure.is_some() || ls.face.is_some() {
                         return Err(self.error_at(l.span(), &key, "a moment load takes `moment` (and no `force`, `pressure` or `face`: it acts through both faces)"));
                     }
-                    if !ls.follower && m.0[2] != 0.0 {
+                    // the plate's fibre carries no twist about itself: the part of the couple along
+                    // the fibre is dropped (all of m3 at the start, fixed or follower alike)
+                    if m.0[2] != 0.0 {
+                        let kind = if ls.follower { "a follower couple (follower = true)" } else { "a fixed couple (follower = false)" };
+                        let whole = if m.0[0] == 0.0 && m.0[1] == 0.0 { " (with m1 = m2 = 0 the whole load would be dropped)" } else { "" };
                         return Err(self.error_at(
                             l.span(),
                             &format!("{key}.moment"),
-                            format!("a fixed couple (follower = false) cannot twist about the plate's normal: m3 must be 0, got {}", num(m.0[2])),
+                            format!("{kind} cannot twist about the plate's normal: m3 must be 0, got {}{whole}", num(m.0[2])),
                         ));
                     }
                 }

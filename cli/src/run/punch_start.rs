@@ -23,11 +23,20 @@ pub struct PointGap {
     pub gap: f64,
     /// Unit normal of the punch surface there (grad Psi / |grad Psi|, pointing away from the punch).
     pub normal: [f64; 3],
+    /// Where the gradient flow from `x` meets the punch's surface (Psi = 0): the punch's point
+    /// nearest to `x` for the sphere, the cylinder and the plane. None when the flow did not end
+    /// on the surface.
+    pub foot: Option<[f64; 3]>,
 }
 
 /// Distance from `x` to the surface along the gradient flow (negative inside) and the unit normal
 /// grad Psi / |grad Psi| at `x`; None where the gradient vanishes (the centre of a sphere).
 pub fn gap_at(surface: &dyn ContactSurface, x: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
+    gap_and_foot(surface, x).map(|(g, n, _)| (g, n))
+}
+
+/// [`gap_at`] and the end of the flow on the surface (None if the flow did not reach Psi = 0).
+pub fn gap_and_foot(surface: &dyn ContactSurface, x: &Vector3<f64>) -> Option<(f64, Vector3<f64>, Option<Vector3<f64>>)> {
     let g0 = surface.gradient(x);
     let psi0 = surface.psi(x);
     let n0 = g0.norm();
@@ -50,9 +59,11 @@ pub fn gap_at(surface: &dyn ContactSurface, x: &Vector3<f64>) -> Option<(f64, Ve
     }
     let dist = (y - x).norm();
     if !dist.is_finite() {
-        return Some((psi0 / n0, g0 / n0));
+        return Some((psi0 / n0, g0 / n0, None));
     }
-    Some((if psi0 < 0.0 { -dist } else { dist }, g0 / n0))
+    // the flow ended on the surface: Psi there is round-off against Psi at the start
+    let on_surface = surface.psi(&y).abs() <= 1e-6 * psi0.abs().max(n0 * 1e-9 * scale);
+    Some((if psi0 < 0.0 { -dist } else { dist }, g0 / n0, on_surface.then_some(y)))
 }
 
 /// The gap of every candidate point of `pair` with the punch where it starts (no motion yet).
@@ -62,10 +73,10 @@ pub fn start_gaps(pair: &ContactPair) -> Vec<PointGap> {
         .enumerate()
         .filter_map(|(k, p)| {
             let x = Vector3::from(p.x_ref);
-            let (gap, n) = gap_at(&*pair.surface, &x)?;
+            let (gap, n, foot) = gap_and_foot(&*pair.surface, &x)?;
             // round-off in the normal must not hold a motion the punch cannot hold
             let n = n.map(|c| if c.abs() < 1e-9 { 0.0 } else { c });
-            Some(PointGap { index: k, node: p.node, x: p.x_ref, gap, normal: n.into() })
+            Some(PointGap { index: k, node: p.node, x: p.x_ref, gap, normal: n.into(), foot: foot.map(Into::into) })
         })
         .collect()
 }

@@ -73,7 +73,7 @@ pub fn check_levels_fit(sizes: &[(u64, u64)], levels: usize, dofs_per_node: u64,
 fn edit_summary(dir: &Path, edit: impl FnOnce(&mut Value)) -> Result<()> {
     let path = dir.join("summary.json");
     let text = std::fs::read_to_string(&path).map_err(|e| StampError::io(&path, e))?;
-    let mut v: Value = serde_json::from_str(&text).map_err(|e| StampError::Problem(format!("{}: cannot read back summary.json: {e}", path.display())))?;
+    let mut v: Value = serde_json::from_str(&text).map_err(|e| StampError::Problem(format!("{}: cannot read back summary.json: {e}", stamp::show_path(&path))))?;
     edit(&mut v);
     let text = serde_json::to_string_pretty(&v).map_err(|e| StampError::Problem(format!("cannot encode summary.json: {e}")))?;
     write_string_atomically(&path, &text)
@@ -155,7 +155,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
                 fines.push(f.history);
             }
             Err(e) => {
-                let e = StampError::Problem(format!("{}: the mesh refined {} (results in {}): {e}", p.path.display(), times(level), dir.display()));
+                let e = StampError::Problem(format!("{}: the mesh refined {} (results in {}): {e}", stamp::show_path(&p.path), times(level), stamp::show_path(&dir)));
                 let message = e.to_string();
                 edit_summary(&out_dir, |v| {
                     v["status"] = json!("failed");

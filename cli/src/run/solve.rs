@@ -366,6 +366,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let mut surface_error: Option<StampError> = None;
     let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
+    // the state before each step, for the checks after it (super::psi_checks)
+    let mut u_prev = u.clone();
+    let layout = Layout::of(&model.element);
+    let size = mesh.mesh.coords.iter().flat_map(|x| x.iter()).fold(section.thickness(), |m, v| m.max(v.abs()));
     let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
         total_iterations += rep.iterations;
         total_failed += rep.failed_iterations;
@@ -375,12 +379,14 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         // a punch whose Psi was not finite somewhere (an expression's sqrt of a negative number)
         // stops the run: its answer would be wrong
         if surface_error.is_none() {
-            surface_error = surface_failure(p, &m.contacts);
+            surface_error = surface_failure(p, &m.contacts)
+                .or_else(|| super::psi_checks::after_step(p, &mesh, &m.contacts, &layout, size, rep.step, (t_last, &u_prev), (rep.load_factor, u)));
             if surface_error.is_some() {
                 stop.store(true, std::sync::atomic::Ordering::Relaxed);
                 return;
             }
         }
+        u_prev.copy_from_slice(u);
         let t = rep.load_factor;
         path_len += (t - t_last).abs();
         t_last = t;

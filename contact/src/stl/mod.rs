@@ -4,5 +4,5 @@
 mod reader;
 mod surface;
 
-pub use reader::{read_stl, TriangleMesh, BYTES_PER_FACET, DEFAULT_MAX_FACETS};
+pub use reader::{parse_stl_bytes, read_stl, TriangleMesh, BYTES_PER_FACET, DEFAULT_MAX_FACETS};
 pub use surface::StlSurface;

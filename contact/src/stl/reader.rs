@@ -6,6 +6,10 @@
 //! The facet normal stored in the file is ignored: the orientation is the vertex order
 //! (counter-clockwise seen from the side the normal points to, the STL convention).
 //!
+//! An ASCII file may hold several solids one after the other (`solid` ... `endsolid`, as CAD
+//! programs write a body of several parts): the die is all their facets together. Anything else
+//! after the last `endsolid`, or between `solid` and the first `facet`, is refused with its line.
+//!
 //! Binary or ASCII: a file whose size is exactly 84 + 50 N bytes, N the count in its header, is
 //! binary; otherwise a file starting with `solid` is ASCII; anything else is a binary file whose
 //! size does not match its header (truncated or padded). The header's count is checked against the
@@ -48,14 +52,20 @@ pub fn read_stl(path: &Path, max_facets: usize) -> Result<TriangleMesh> {
         return Err(too_many(path, format!("the file has {size} bytes"), max_facets));
     }
     let bytes = std::fs::read(path).map_err(|e| input_error(path, format!("cannot read the STL file: {e}")))?;
+    parse_stl_bytes(path, &bytes, max_facets)
+}
+
+/// Parses and checks the bytes of an STL file (`path` names it in errors) with at most
+/// `max_facets` facets: [`read_stl`] without the file system.
+pub fn parse_stl_bytes(path: &Path, bytes: &[u8], max_facets: usize) -> Result<TriangleMesh> {
     let soup = if let Some(n) = binary_count(&bytes) {
         if 84 + 50 * n as u64 == bytes.len() as u64 {
             if n as usize > max_facets {
                 return Err(too_many(path, format!("the header announces {n} facets"), max_facets));
             }
-            read_binary(path, &bytes, n as usize)?
+            read_binary(path, bytes, n as usize)?
         } else if bytes.starts_with(b"solid") {
-            read_ascii(path, &bytes, max_facets)?
+            read_ascii(path, bytes, max_facets)?
         } else {
             return Err(input_error(
                 path,
@@ -67,7 +77,7 @@ pub fn read_stl(path: &Path, max_facets: usize) -> Result<TriangleMesh> {
             ));
         }
     } else if bytes.starts_with(b"solid") {
-        read_ascii(path, &bytes, max_facets)?
+        read_ascii(path, bytes, max_facets)?
     } else {
         return Err(input_error(
             path,
@@ -125,7 +135,7 @@ fn read_ascii(path: &Path, bytes: &[u8], max_facets: usize) -> Result<Soup> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         input_error(path, format!("ASCII STL: not valid text at byte {} (nor a binary STL of matching size)", e.valid_up_to()))
     })?;
-    let mut tokens = text
+    let tokens = text
         .lines()
         .enumerate()
         .flat_map(|(l, line)| line.split_whitespace().map(move |t| (l + 1, t)));
@@ -138,44 +148,58 @@ fn read_ascii(path: &Path, bytes: &[u8], max_facets: usize) -> Result<Soup> {
             None => Err(input_error(path, format!("facet {facet}: the file ends where `{want}` is expected"))),
         }
     };
-    // `solid` and its optional name, up to the first `facet` or `endsolid`
-    tokens.next();
-    let mut next = tokens.next();
-    while let Some((_, t)) = next {
-        if t == "facet" || t == "endsolid" {
-            break;
-        }
-        next = tokens.next();
-    }
+    // one or more solids, each `solid [name]` ... `endsolid [name]` (the names on the keyword's own
+    // line); after the last, nothing but blanks: a word anywhere else is refused with its line
+    let mut tokens = tokens.peekable();
+    let mut solids = 0usize;
     loop {
-        let facet = soup.len() + 1;
-        match next {
-            Some((_, "facet")) => {}
-            Some((_, "endsolid")) => break,
-            Some((l, t)) => return Err(err(l, format!("expected `facet` or `endsolid`, found '{}'", quote(t)))),
-            None => return Err(input_error(path, format!("ASCII STL: the file ends after {} facets without `endsolid`", soup.len()))),
-        }
-        if soup.len() >= max_facets {
-            return Err(too_many(path, format!("more than {max_facets} facets"), max_facets));
-        }
-        expect(tokens.next(), "normal", facet)?;
-        for _ in 0..3 {
-            number(path, tokens.next(), facet)?;
-        }
-        expect(tokens.next(), "outer", facet)?;
-        expect(tokens.next(), "loop", facet)?;
-        let mut v = [[0.0; 3]; 3];
-        for vertex in v.iter_mut() {
-            expect(tokens.next(), "vertex", facet)?;
-            for c in vertex.iter_mut() {
-                *c = number(path, tokens.next(), facet)?;
+        match tokens.next() {
+            // the file starts with `solid` (checked): its first word may run into the name
+            Some((l, t)) if t == "solid" || (solids == 0 && t.starts_with("solid")) => {
+                while tokens.peek().is_some_and(|&(l2, _)| l2 == l) {
+                    tokens.next();
+                }
             }
+            Some((l, t)) => {
+                return Err(err(l, format!("after `endsolid` of solid {solids}: expected `solid` (another solid) or the end of the file, found '{}'", quote(t))));
+            }
+            None => break,
         }
-        expect(tokens.next(), "endloop", facet)?;
-        expect(tokens.next(), "endfacet", facet)?;
-        check_finite(path, facet, &v)?;
-        soup.push(v);
-        next = tokens.next();
+        solids += 1;
+        loop {
+            let facet = soup.len() + 1;
+            match tokens.next() {
+                Some((_, "facet")) => {}
+                Some((l, "endsolid")) => {
+                    while tokens.peek().is_some_and(|&(l2, _)| l2 == l) {
+                        tokens.next();
+                    }
+                    break;
+                }
+                Some((l, t)) => return Err(err(l, format!("expected `facet` or `endsolid`, found '{}'", quote(t)))),
+                None => return Err(input_error(path, format!("ASCII STL: the file ends after {} facets without `endsolid`", soup.len()))),
+            }
+            if soup.len() >= max_facets {
+                return Err(too_many(path, format!("more than {max_facets} facets"), max_facets));
+            }
+            expect(tokens.next(), "normal", facet)?;
+            for _ in 0..3 {
+                number(path, tokens.next(), facet)?;
+            }
+            expect(tokens.next(), "outer", facet)?;
+            expect(tokens.next(), "loop", facet)?;
+            let mut v = [[0.0; 3]; 3];
+            for vertex in v.iter_mut() {
+                expect(tokens.next(), "vertex", facet)?;
+                for c in vertex.iter_mut() {
+                    *c = number(path, tokens.next(), facet)?;
+                }
+            }
+            expect(tokens.next(), "endloop", facet)?;
+            expect(tokens.next(), "endfacet", facet)?;
+            check_finite(path, facet, &v)?;
+            soup.push(v);
+        }
     }
     Ok(soup)
 }
@@ -248,4 +272,94 @@ fn check_facets(path: &Path, mesh: &TriangleMesh) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (xorshift64*): the same inputs on every run.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+        fn below(&mut self, n: usize) -> usize {
+            (self.next() % n.max(1) as u64) as usize
+        }
+    }
+
+    const TETRAHEDRON: &str = "solid t\n facet normal 0 0 -1\n  outer loop\n   vertex 0 0 0\n   vertex 0 1 0\n   vertex 1 0 0\n  endloop\n endfacet\n \
+facet normal 0 -1 0\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 0 1\n  endloop\n endfacet\n \
+facet normal -1 0 0\n  outer loop\n   vertex 0 0 0\n   vertex 0 0 1\n   vertex 0 1 0\n  endloop\n endfacet\n \
+facet normal 1 1 1\n  outer loop\n   vertex 1 0 0\n   vertex 0 1 0\n   vertex 0 0 1\n  endloop\n endfacet\nendsolid t\n";
+
+    /// The binary form of the tetrahedron above.
+    fn binary() -> Vec<u8> {
+        let mesh = parse_stl_bytes(Path::new("t.stl"), TETRAHEDRON.as_bytes(), 100).unwrap();
+        let mut b = vec![0u8; 80];
+        b.extend((mesh.facets.len() as u32).to_le_bytes());
+        for f in &mesh.facets {
+            b.extend([0u8; 12]);
+            for &v in f {
+                for c in mesh.vertices[v as usize] {
+                    b.extend((c as f32).to_le_bytes());
+                }
+            }
+            b.extend([0u8; 2]);
+        }
+        b
+    }
+
+    /// `bytes` with a few random edits: bytes flipped, cut, repeated, inserted words.
+    fn mutate(rng: &mut Rng, bytes: &[u8]) -> Vec<u8> {
+        let mut b = bytes.to_vec();
+        for _ in 0..1 + rng.below(4) {
+            let at = rng.below(b.len() + 1);
+            match rng.below(6) {
+                0 if at < b.len() => b[at] = rng.next() as u8,
+                1 => b.truncate(at),
+                2 => {
+                    let words: [&[u8]; 8] = [b"solid", b"endsolid", b"facet", b" nan ", b" 1e308 ", b"\n", b"vertex", b"-0"];
+                    let w = words[rng.below(words.len())];
+                    b.splice(at.min(b.len())..at.min(b.len()), w.iter().copied());
+                }
+                3 if at + 50 <= b.len() => {
+                    let piece = b[at..at + 50].to_vec();
+                    b.splice(at..at, piece);
+                }
+                4 if b.len() >= 84 => b[80..84].copy_from_slice(&(rng.next() as u32).to_le_bytes()),
+                _ => b.extend((0..rng.below(8)).map(|_| rng.next() as u8)),
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn hundreds_of_mutated_files_give_a_mesh_or_an_error_never_a_panic() {
+        let mut rng = Rng(0x5eed_2026);
+        let seeds = [TETRAHEDRON.as_bytes().to_vec(), binary()];
+        let (mut ok, mut err) = (0, 0);
+        for k in 0..600 {
+            let input = if k % 10 == 9 { (0..rng.below(300)).map(|_| rng.next() as u8).collect() } else { mutate(&mut rng, &seeds[k % 2]) };
+            match parse_stl_bytes(Path::new("fuzz.stl"), &input, 1000) {
+                Ok(m) => {
+                    ok += 1;
+                    assert!(!m.facets.is_empty());
+                    assert!(m.facets.iter().flatten().all(|&v| (v as usize) < m.vertices.len()));
+                    assert!(m.vertices.iter().flatten().all(|c| c.is_finite()));
+                }
+                Err(e) => {
+                    err += 1;
+                    let msg = e.to_string();
+                    assert!(msg.starts_with("fuzz.stl: ") && msg.len() < 1000, "{msg}");
+                }
+            }
+        }
+        // both outcomes are exercised
+        assert!(ok > 10 && err > 100, "{ok} read, {err} refused");
+    }
 }
