@@ -5,7 +5,8 @@
 //! * [`build`]: section, plate elements, constraints, loads, punches, solver settings;
 //! * [`check`]: what is wrong with a built problem, said before the solve (`stamp check`), with
 //!   [`rigid_modes`] (rigid motions held by nothing) and [`punch_start`] (gaps at the start);
-//! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those);
+//! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those),
+//!   locked by [`folder_lock`] against a second run; [`regular`] refuses FIFOs and the like there;
 //! * [`solve`]: Newton-Raphson along the targets with a progress bar, writing every step;
 //! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step;
 //! * [`refine`]: `stamp run --refine`, the run on refined meshes, with [`richardson`] and
@@ -14,6 +15,7 @@
 
 pub mod build;
 pub mod coarse;
+pub mod folder_lock;
 pub mod check;
 pub mod history;
 pub mod memory;
@@ -27,6 +29,7 @@ pub mod problem;
 pub mod punch_start;
 pub mod refine;
 pub mod refine_report;
+pub mod regular;
 pub mod richardson;
 pub mod rigid_modes;
 pub mod solve;

@@ -15,6 +15,7 @@
 //! manifest) loses what that summary.json names: summary.json, the steps' .vtu and .csv files,
 //! the .pvd and the punches' pressure plots.
 
+use super::folder_lock::{FolderLock, LOCK_FILE};
 use serde::{Deserialize, Serialize};
 use stamp::io::write_string_atomically;
 use stamp::{Result, StampError};
@@ -45,6 +46,8 @@ pub struct RunFolder {
     before: BTreeMap<OsString, Option<SystemTime>>,
     /// Files the claim removed (the previous run's).
     pub removed: Vec<String>,
+    /// No other run writes into the folder while this one holds it.
+    _lock: FolderLock,
 }
 
 /// Regular files of `dir` (not the manifest) with their modification times.
@@ -53,7 +56,7 @@ fn listing(dir: &Path) -> Result<BTreeMap<OsString, Option<SystemTime>>> {
     for entry in std::fs::read_dir(dir).map_err(|e| StampError::io(dir, e))? {
         let entry = entry.map_err(|e| StampError::io(dir, e))?;
         let Ok(meta) = entry.metadata() else { continue };
-        if meta.is_file() && entry.file_name() != MANIFEST {
+        if meta.is_file() && entry.file_name() != MANIFEST && entry.file_name() != LOCK_FILE {
             out.insert(entry.file_name(), meta.modified().ok());
         }
     }
@@ -62,7 +65,7 @@ fn listing(dir: &Path) -> Result<BTreeMap<OsString, Option<SystemTime>>> {
 
 /// A bare file name (no path separators, not "." or ".."): the only names the manifest may remove.
 fn plain_name(name: &str) -> bool {
-    !name.is_empty() && name != "." && name != ".." && !name.contains('/') && !name.contains('\\') && name != MANIFEST
+    !name.is_empty() && name != "." && name != ".." && !name.contains('/') && !name.contains('\\') && name != MANIFEST && name != LOCK_FILE
 }
 
 /// Named like one of stamp's outputs.
@@ -106,15 +109,17 @@ fn legacy_outputs(dir: &Path) -> Vec<String> {
 }
 
 impl RunFolder {
-    /// Create `dir` if needed, remove the previous run's files and mark the folder as in use.
+    /// Create `dir` if needed, lock it (refused while another run holds it, see
+    /// [`FolderLock`]), remove the previous run's files and mark the folder as in use.
     pub fn claim(dir: &Path) -> Result<RunFolder> {
         std::fs::create_dir_all(dir).map_err(|e| StampError::io(dir, e))?;
+        let lock = FolderLock::acquire(dir)?;
         let mut removed = remove_previous_outputs(dir, true)?;
         removed.extend(remove_refined_runs(dir)?);
         let before = listing(dir)?;
         let manifest = Manifest { status: "running".into(), written: Vec::new(), before: before.keys().filter_map(|k| k.to_str().map(String::from)).collect() };
         write_manifest(dir, &manifest)?;
-        Ok(RunFolder { dir: dir.to_path_buf(), before, removed })
+        Ok(RunFolder { dir: dir.to_path_buf(), before, removed, _lock: lock })
     }
 
     /// The files written since the claim: new ones, and old ones rewritten.
@@ -180,8 +185,12 @@ fn remove_refined_runs(dir: &Path) -> Result<Vec<String>> {
         if !is_refined_name || !is_dir || !sub.join(MANIFEST).is_file() {
             continue;
         }
+        // refused while a run writes into it
+        let lock = FolderLock::acquire(&sub)?;
         removed.extend(remove_previous_outputs(&sub, false)?.into_iter().map(|f| format!("{name}/{f}")));
         std::fs::remove_file(sub.join(MANIFEST)).map_err(|e| StampError::io(&sub.join(MANIFEST), e))?;
+        let _ = std::fs::remove_file(sub.join(LOCK_FILE));
+        drop(lock);
         // only if empty: files the user put there stay, and so does the folder
         let _ = std::fs::remove_dir(&sub);
     }
@@ -228,7 +237,7 @@ mod tests {
                 std::fs::write(d.join(format!("a_{k:04}.vtu")), "x").unwrap();
             }
         }
-        assert_eq!(names(&d), [".stamp-run", "a_0001.vtu", "a_0002.vtu", "a_0003.vtu", "notes.txt"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "a_0001.vtu", "a_0002.vtu", "a_0003.vtu", "notes.txt"]);
         // a file the user adds afterwards, even named like an output, survives the next run
         std::fs::write(d.join("b_0009.vtu"), "mine").unwrap();
         {
@@ -236,7 +245,7 @@ mod tests {
             assert_eq!(f.removed, ["a_0001.vtu", "a_0002.vtu", "a_0003.vtu"]);
             std::fs::write(d.join("a_0001.vtu"), "y").unwrap();
         }
-        assert_eq!(names(&d), [".stamp-run", "a_0001.vtu", "b_0009.vtu", "notes.txt"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "a_0001.vtu", "b_0009.vtu", "notes.txt"]);
     }
 
     #[test]
@@ -276,7 +285,7 @@ mod tests {
         let f = RunFolder::claim(&d).unwrap();
         assert_eq!(f.removed, ["a_0001.vtu", "summary.json"]);
         drop(f);
-        assert_eq!(names(&d), [".stamp-run", "later.txt", "notes.txt"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "later.txt", "notes.txt"]);
     }
 
     #[test]
@@ -288,6 +297,6 @@ mod tests {
         }
         std::fs::write(d.join("summary.json"), summary).unwrap();
         drop(RunFolder::claim(&d).unwrap());
-        assert_eq!(names(&d), [".stamp-run", "notes.txt", "p_0002.vtu"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "notes.txt", "p_0002.vtu"]);
     }
 }

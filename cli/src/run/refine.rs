@@ -102,6 +102,9 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     let sizes = stamp::mesh_refine::refined_sizes(&setup.mesh.mesh, levels);
     check_levels_fit(&sizes, levels, super::memory::dofs_per_node(p.spec.plate.get_ref().surfaces), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
+    // the folder is this run's until the last mesh is solved (the runs below claim it again)
+    std::fs::create_dir_all(&out_dir).map_err(|e| StampError::io(&out_dir, e))?;
+    let _lock = super::folder_lock::FolderLock::acquire(&out_dir)?;
     let units = Units::new(p.spec.units.as_ref());
     let force_driven: Vec<bool> = p.spec.punch.iter().map(|s| s.get_ref().force.is_some()).collect();
     let mut meshes = vec![mesh_entry(0, &setup.mesh)];

@@ -1,0 +1,92 @@
+//! A run against what happens around it: a second run into its folder, signals, kill -9, files of
+//! the folder that are not regular files, input files in the output folder.
+
+mod common;
+use common::*;
+use std::path::Path;
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// A run of about 10 000 quick steps (a small clamped plate pushed down by 1e-4 of the path at a
+/// time; only the target is written): long enough to be interrupted.
+const LONG: &str = r#"[mesh]
+rectangle = { x = [0.0, 8.0], y = [0.0, 8.0], n = [16, 16] }
+[plate]
+thickness = 1.0
+E = 1000.0
+nu = 0.3
+kinematics = "linear"
+[[boundary]]
+group = "boundary"
+fix = ["clamped"]
+[[punch]]
+name = "ball"
+shape = "sphere"
+center = [4.0, 4.0, 20.5]
+radius = 20.0
+motion = [0.0, 0.0, -0.05]
+[solver]
+max_increment = 1e-4
+[output]
+every_step = false
+plot = false
+"#;
+
+/// The same plate in two written steps: quick.
+fn short() -> String {
+    LONG.replace("max_increment = 1e-4", "steps = 2").replace("every_step = false", "every_step = true")
+}
+
+fn stamp() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_stamp"))
+}
+
+fn run_out(problem: &Path, out: &Path) -> Output {
+    stamp().args(["run", "-q", "--out"]).arg(out).arg(problem).output().unwrap()
+}
+
+/// Start a run of `problem` into `out` and wait until its summary.json says "running" with a
+/// converged step in history.csv (it is then inside the solve).
+fn start(problem: &Path, out: &Path) -> Child {
+    let mut child = stamp().args(["run", "-q", "--out"]).arg(out).arg(problem).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+    let t0 = Instant::now();
+    loop {
+        let ready = std::fs::read_to_string(out.join("history.csv")).map(|h| h.lines().count() > 3).unwrap_or(false);
+        if ready {
+            return child;
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("the run ended before it was under way: {status}");
+        }
+        assert!(t0.elapsed() < Duration::from_secs(60), "the run did not start");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn kill(child: &Child, signal: &str) {
+    let ok = Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap().success();
+    assert!(ok, "kill {signal} failed");
+}
+
+#[test]
+fn a_second_run_into_a_folder_in_use_is_refused_until_the_first_is_gone() {
+    let dir = temp_dir("lock");
+    let out = dir.join("out");
+    let long = write(&dir, "long.toml", LONG);
+    let other = write(&dir, "other.toml", &short());
+    let mut first = start(&long, &out);
+    let o = run_out(&other, &out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "the second run was let in: {err}");
+    assert!(err.contains("in use") && err.contains(&format!("process {}", first.id())), "{err}");
+    // the first run's files are still there, and it still runs
+    assert!(out.join("summary.json").is_file() && out.join("history.csv").is_file());
+    assert!(first.try_wait().unwrap().is_none(), "the first run ended");
+    assert!(!out.join("other.pvd").exists());
+    // killed without a chance to clean up: its lock is stale and taken over
+    kill(&first, "-KILL");
+    first.wait().unwrap();
+    let o = run_out(&other, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(summary(&out)["status"], "converged");
+}
