@@ -3,6 +3,7 @@
 
 mod common;
 use common::*;
+use std::os::unix::fs::FileTypeExt;
 use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -89,4 +90,39 @@ fn a_second_run_into_a_folder_in_use_is_refused_until_the_first_is_gone() {
     let o = run_out(&other, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(summary(&out)["status"], "converged");
+}
+
+/// Run `stamp run` on `problem` into `out`; a run still going after `secs` seconds is killed and
+/// reported as hanging.
+fn run_within(problem: &Path, out: &Path, secs: u64) -> Output {
+    let mut child = stamp().args(["run", "-q", "--out"]).arg(out).arg(problem).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let t0 = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > Duration::from_secs(secs) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("stamp run hangs (killed after {secs} s)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn a_fifo_in_place_of_the_runs_own_files_is_refused_at_once() {
+    let dir = temp_dir("fifo");
+    let p = write(&dir, "p.toml", &short());
+    for name in [".stamp-run", "summary.json", ".stamp-lock"] {
+        let out = dir.join(format!("out{}", name.replace('.', "_")));
+        std::fs::create_dir_all(&out).unwrap();
+        let fifo = out.join(name);
+        assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let o = run_within(&p, &out, 20);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{name}: {err}");
+        assert!(err.contains(&fifo.display().to_string()) && err.contains("is a FIFO, not a regular file"), "{name}: {err}");
+        // nothing written, the FIFO left alone
+        assert!(!out.join("p.pvd").exists() && !out.join("history.csv").exists(), "{name}");
+        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo(), "{name}");
+    }
 }

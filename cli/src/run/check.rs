@@ -317,7 +317,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
 /// After a run: the punches that had no node in contact at any step recorded in `summary`
 /// (summary.json), one warning each.
 pub fn never_touched(p: &Problem, summary: &Path) -> Vec<String> {
-    let Ok(text) = std::fs::read_to_string(summary) else { return Vec::new() };
+    let Ok(Some(text)) = super::regular::read_regular(summary) else { return Vec::new() };
     let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
     let Some(steps) = json["steps"].as_array() else { return Vec::new() };
     let converged: Vec<&serde_json::Value> = steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).collect();

@@ -16,6 +16,7 @@
 //! the .pvd and the punches' pressure plots.
 
 use super::folder_lock::{FolderLock, LOCK_FILE};
+use super::regular::{read_regular, refuse_non_regular};
 use serde::{Deserialize, Serialize};
 use stamp::io::write_string_atomically;
 use stamp::{Result, StampError};
@@ -79,11 +80,11 @@ fn looks_like_output(name: &str) -> bool {
 }
 
 /// The files a summary.json written without a manifest names.
-fn legacy_outputs(dir: &Path) -> Vec<String> {
-    let Ok(text) = std::fs::read_to_string(dir.join("summary.json")) else { return Vec::new() };
-    let Ok(s) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
+fn legacy_outputs(dir: &Path) -> Result<Vec<String>> {
+    let Some(text) = read_regular(&dir.join("summary.json"))? else { return Ok(Vec::new()) };
+    let Ok(s) = serde_json::from_str::<serde_json::Value>(&text) else { return Ok(Vec::new()) };
     if !(s["steps"].is_array() && s["problem"].is_string()) {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let mut names = vec!["summary.json".to_string()];
     for step in s["steps"].as_array().unwrap() {
@@ -105,7 +106,7 @@ fn legacy_outputs(dir: &Path) -> Vec<String> {
             names.push(format!("pressure_{n}.svg"));
         }
     }
-    names
+    Ok(names)
 }
 
 impl RunFolder {
@@ -114,6 +115,10 @@ impl RunFolder {
     pub fn claim(dir: &Path) -> Result<RunFolder> {
         std::fs::create_dir_all(dir).map_err(|e| StampError::io(dir, e))?;
         let lock = FolderLock::acquire(dir)?;
+        // the files of its own a run reads back or replaces: never a FIFO or a device
+        for name in [MANIFEST, "summary.json"] {
+            refuse_non_regular(&dir.join(name))?;
+        }
         let mut removed = remove_previous_outputs(dir, true)?;
         removed.extend(remove_refined_runs(dir)?);
         let before = listing(dir)?;
@@ -145,8 +150,8 @@ impl RunFolder {
 /// Removes the files the previous run wrote in `dir` (see the module notes; `legacy`: also a
 /// folder written before manifests existed) and returns their names.
 fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {
-    let previous: Vec<String> = match std::fs::read_to_string(dir.join(MANIFEST)) {
-        Ok(text) => match serde_json::from_str::<Manifest>(&text) {
+    let previous: Vec<String> = match read_regular(&dir.join(MANIFEST))? {
+        Some(text) => match serde_json::from_str::<Manifest>(&text) {
             Ok(m) if m.status == "complete" => m.written,
             Ok(m) => {
                 // killed mid-run: stamp-named files that were not there before it
@@ -155,8 +160,8 @@ fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {
             }
             Err(_) => Vec::new(),
         },
-        Err(_) if legacy => legacy_outputs(dir),
-        Err(_) => Vec::new(),
+        None if legacy => legacy_outputs(dir)?,
+        None => Vec::new(),
     };
     let mut removed = Vec::new();
     for name in previous.iter().filter(|n| plain_name(n)) {

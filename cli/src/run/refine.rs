@@ -72,7 +72,7 @@ pub fn check_levels_fit(sizes: &[(u64, u64)], levels: usize, dofs_per_node: u64,
 /// Rewrite summary.json in `dir` with `edit` applied (atomically).
 fn edit_summary(dir: &Path, edit: impl FnOnce(&mut Value)) -> Result<()> {
     let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| StampError::io(&path, e))?;
+    let text = super::regular::read_regular(&path)?.ok_or_else(|| StampError::io(&path, std::io::ErrorKind::NotFound.into()))?;
     let mut v: Value = serde_json::from_str(&text).map_err(|e| StampError::Problem(format!("{}: cannot read back summary.json: {e}", path.display())))?;
     edit(&mut v);
     let text = serde_json::to_string_pretty(&v).map_err(|e| StampError::Problem(format!("cannot encode summary.json: {e}")))?;
