@@ -126,3 +126,35 @@ fn a_fifo_in_place_of_the_runs_own_files_is_refused_at_once() {
         assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo(), "{name}");
     }
 }
+
+#[test]
+fn an_input_named_like_an_output_in_the_output_folder_is_refused() {
+    let meshes = repo().join("meshes");
+    let cases = [
+        ("disk-clamped.toml", "file = \"disk-clamped.msh\"", "disk-clamped.msh", "history.csv", "mesh.file"),
+        ("stl-die.toml", "file = \"stl-die.stl\"", "stl-die.stl", "probe_die_0001.csv", "punch[0].file"),
+        ("stl-die.toml", "file = \"stl-die.stl\"", "stl-die.stl", "p_0001.vtu", "punch[0].file"),
+    ];
+    for (k, (shipped, line, input, name, key)) in cases.into_iter().enumerate() {
+        let dir = temp_dir(&format!("inputs{k}"));
+        let out = dir.join("out");
+        std::fs::create_dir_all(&out).unwrap();
+        std::fs::copy(meshes.join(input), out.join(name)).unwrap();
+        let original = std::fs::read(out.join(name)).unwrap();
+        let text = std::fs::read_to_string(meshes.join(shipped)).unwrap().replace(line, &format!("file = \"out/{name}\""));
+        let p = write(&dir, "p.toml", &text);
+        let o = run_out(&p, &out);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{name}: {err}");
+        assert!(err.contains(key) && err.contains(name) && err.contains("named like one of stamp's outputs"), "{name}: {err}");
+        assert_eq!(std::fs::read(out.join(name)).unwrap(), original, "{name} was changed");
+        assert!(!out.join("summary.json").exists(), "{name}");
+    }
+    // the problem file itself
+    let dir = temp_dir("inputs-problem");
+    let p = write(&dir, "summary.json", &short());
+    let o = run_out(&p, &dir);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("the problem file") && err.contains("summary.json"), "{err}");
+    assert_eq!(std::fs::read_to_string(&p).unwrap(), short());
+}

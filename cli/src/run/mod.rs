@@ -22,6 +22,7 @@ pub mod memory;
 pub mod mesh;
 pub mod out_dir;
 pub mod output;
+pub mod own_inputs;
 pub mod plate_model;
 pub mod plot;
 pub mod probe;

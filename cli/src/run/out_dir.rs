@@ -70,7 +70,7 @@ fn plain_name(name: &str) -> bool {
 }
 
 /// Named like one of stamp's outputs.
-fn looks_like_output(name: &str) -> bool {
+pub fn looks_like_output(name: &str) -> bool {
     name == "summary.json"
         || name.ends_with(".vtu")
         || name.ends_with(".pvd")

@@ -243,6 +243,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let quiet = opts.quiet;
     let start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
+    super::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
     // removes the previous run's files; records this run's when dropped (see out_dir.rs)
     let _folder = super::out_dir::RunFolder::claim(out_dir)?;
     let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
