@@ -68,11 +68,11 @@ pub fn check_command(problem: &Path) -> stamp::Result<()> {
     let p = Problem::read(problem)?;
     let setup = build::build(&p)?;
     let report = check::check(&p, &setup)?;
-    println!("{}", report.summary);
+    crate::outln!("{}", report.summary);
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
-    println!("check: no errors{}", match report.warnings.len() {
+    crate::outln!("check: no errors{}", match report.warnings.len() {
         0 => String::new(),
         1 => ", 1 warning".into(),
         n => format!(", {n} warnings"),
@@ -93,7 +93,7 @@ pub fn run_command(problem: &Path, out: Option<&Path>, quiet: bool, refine: Opti
             Some(n) => format!("; the refined meshes' in {} ... {}", outcome.out_dir.join(refine::level_folder(1)).display(), refine::level_folder(n)),
             None => String::new(),
         };
-        println!(
+        crate::outln!(
             "stamp run: {} converged steps; results in {} (summary.json, .pvd/.vtu, CSV){refined}",
             outcome.converged_steps,
             outcome.out_dir.display()

@@ -196,9 +196,9 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         v["refinement"]["seconds"] = json!(seconds);
     })?;
     if !quiet {
-        print!("{}", super::table::render(&coarse.history, &units));
-        print!("{}", rep.tables(&coarse.history));
-        println!("{}", explanation(levels));
+        crate::out!("{}", super::table::render(&coarse.history, &units));
+        crate::out!("{}", rep.tables(&coarse.history));
+        crate::outln!("{}", explanation(levels));
     }
     Ok(RunOutcome { files, ..coarse })
 }

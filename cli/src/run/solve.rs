@@ -510,7 +510,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         failure = failure.or(Some(e));
     }
     if !quiet && (!opts.no_table || failure.is_some()) {
-        print!("{}", super::table::render(&history, &units));
+        crate::out!("{}", super::table::render(&history, &units));
     }
     summary.seconds = start.elapsed().as_secs_f64();
     match &failure {
