@@ -45,6 +45,10 @@ pub enum StampError {
         tolerance: f64,
         reason: String,
     },
+    /// The solve was interrupted on request (a signal): the step in progress was abandoned, the
+    /// state is that of the last converged step.
+    #[error("interrupted after load step {steps} (load factor {load_factor:.6e}): the step in progress was abandoned")]
+    Interrupted { steps: usize, load_factor: f64 },
     /// An I/O error with the path it concerns.
     #[error("{path}: {source}")]
     Io {

@@ -297,6 +297,10 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// Set (by the step callback, say, after its output failed) to end the path after the current
     /// step: `solve_path` then returns [`StampError::Problem`] "stopped on request".
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Set (by a signal handler, say) to abandon the step in progress: checked before every
+    /// Newton iteration; `solve_path` then returns [`StampError::Interrupted`] with `u` at the
+    /// last converged state.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// The start of each load step, when given: called with (converged steps so far, load factor
     /// of the last converged state, load factor of the step, the start to set); true when it set
     /// the start (then used instead of the secant extrapolation, see
@@ -310,7 +314,7 @@ pub struct NewtonRaphson<L: LinearSolver> {
 
 impl<L: LinearSolver> NewtonRaphson<L> {
     pub fn new(linear: L, settings: NewtonSettings) -> Self {
-        NewtonRaphson { settings, linear, on_iteration: None, stop: None, predictor: None, iterations_done: 0 }
+        NewtonRaphson { settings, linear, on_iteration: None, stop: None, interrupt: None, predictor: None, iterations_done: 0 }
     }
 
     /// Newton iterations done so far by this solver, those of attempts that failed included (a
@@ -318,6 +322,11 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     /// reported).
     pub fn iterations_done(&self) -> usize {
         self.iterations_done
+    }
+
+    /// Whether [`interrupt`](Self::interrupt) was set.
+    fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
@@ -357,6 +366,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         for it in 0.. {
             if it > 0 {
                 self.iterations_done += 1;
+            }
+            if self.interrupted() {
+                return Err(("interrupted".into(), history.last().copied().unwrap_or(f64::NAN), *last_tol));
             }
             let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
@@ -561,6 +573,9 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
             // iterations of the attempts of this step that failed
             let mut failed_iterations = 0;
             while t != target {
+                if self.interrupted() {
+                    return Err(StampError::Interrupted { steps: summary.steps, load_factor: t });
+                }
                 let remaining = target - t;
                 let step_t = if dt >= remaining.abs() * (1.0 - 1e-12) { target } else { t + dt.copysign(remaining) };
                 if step_t == t || !step_t.is_finite() {
@@ -659,6 +674,9 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         failed_iterations += spent;
                         summary.failed_iterations += spent;
                         p.restore();
+                        if self.interrupted() {
+                            return Err(StampError::Interrupted { steps: summary.steps, load_factor: t });
+                        }
                         cutbacks_in_row += 1;
                         summary.cutbacks += 1;
                         dt = 0.5 * (step_t - t).abs();
@@ -865,6 +883,23 @@ mod tests {
         assert!(msg.contains("still violated") && msg.contains("after 3 augmented-Lagrangian updates"), "{msg}");
         // two attempts (one cut-back), each with 1 + 3 solves asking end_step
         assert_eq!(p.restarts, 8);
+    }
+
+    #[test]
+    fn an_interrupt_abandons_the_step_in_progress() {
+        // set at the first Newton iteration of the first step
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let mut newton = NewtonRaphson::new(SparseLu::new(), settings());
+        newton.interrupt = Some(flag.clone());
+        let f = flag.clone();
+        newton.on_iteration = Some(Box::new(move |_, _, _| f.store(true, std::sync::atomic::Ordering::Relaxed)));
+        let mut steps = Vec::new();
+        let e = newton.solve_path(&mut p, &mut u, 0.0, &[0.25, 0.5], &mut |r, _, _| steps.push(r.load_factor)).unwrap_err();
+        assert!(matches!(e, StampError::Interrupted { steps: 0, load_factor: 0.0 }), "{e}");
+        assert!(steps.is_empty() && u[0] == 0.0, "{steps:?} {u:?}");
+        assert!(e.to_string().contains("interrupted after load step 0"), "{e}");
     }
 
     #[test]

@@ -117,7 +117,11 @@ fn main() -> ExitCode {
         }
         (Err(e), _) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            // ended by Ctrl-C or SIGTERM: the status a shell gives a process the signal ended
+            match stamp_cli::run::interrupt::received() {
+                Some(signal) => ExitCode::from(stamp_cli::run::interrupt::exit_status(signal)),
+                None => ExitCode::FAILURE,
+            }
         }
     }
 }

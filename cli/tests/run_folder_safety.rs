@@ -3,6 +3,7 @@
 
 mod common;
 use common::*;
+use std::collections::BTreeSet;
 use std::os::unix::fs::FileTypeExt;
 use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
@@ -157,4 +158,112 @@ fn an_input_named_like_an_output_in_the_output_folder_is_refused() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("the problem file") && err.contains("summary.json"), "{err}");
     assert_eq!(std::fs::read_to_string(&p).unwrap(), short());
+}
+
+/// [`LONG`] listing every step in summary.json (no file per step).
+fn long_listing_steps() -> String {
+    LONG.replace("every_step = false", "every_step = true\nvtu = false\ncsv = false")
+}
+
+/// The data rows of history.csv.
+fn history_rows(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("history.csv")).unwrap().lines().count() - 1
+}
+
+#[test]
+fn ctrl_c_and_sigterm_end_a_run_cleanly_with_the_steps_written() {
+    for (signal, status) in [("-INT", 130), ("-TERM", 143)] {
+        let dir = temp_dir(&format!("signal{signal}"));
+        let out = dir.join("out");
+        let p = write(&dir, "p.toml", &long_listing_steps());
+        let child = start(&p, &out);
+        kill(&child, signal);
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(status), "{signal}: {err}");
+        assert!(err.contains("interrupted") && !err.contains("panicked"), "{signal}: {err}");
+        let s = summary(&out);
+        assert_eq!(s["status"], "interrupted", "{signal}");
+        let name = if signal == "-INT" { "SIGINT" } else { "SIGTERM" };
+        assert!(s["error"].as_str().unwrap().contains(name), "{signal}: {}", s["error"]);
+        // every step listed converged and written, the abandoned one not listed; history.csv the same
+        let steps = s["steps"].as_array().unwrap();
+        assert!(!steps.is_empty() && steps.iter().all(|e| e["converged"] == true), "{signal}: {steps:?}");
+        assert_eq!(steps.len(), history_rows(&out), "{signal}");
+        // the folder is free again: the manifest says the run is over
+        let manifest = std::fs::read_to_string(out.join(".stamp-run")).unwrap();
+        assert!(manifest.contains("\"complete\""), "{signal}: {manifest}");
+    }
+}
+
+#[test]
+fn the_next_run_cleans_up_after_a_run_killed_with_sigkill() {
+    let dir = temp_dir("sigkill");
+    let out = dir.join("out");
+    let long = write(&dir, "long.toml", &LONG.replace("every_step = false", "every_step = true"));
+    let child = start(&long, &out);
+    kill(&child, "-KILL");
+    let mut child = child;
+    child.wait().unwrap();
+    // what a kill in the middle of a write leaves: a temporary file (and maybe a step's files
+    // that summary.json does not list yet)
+    std::fs::write(out.join(".summary.json.tmp-999999-7"), "{\"status\": \"runn").unwrap();
+    std::fs::write(out.join(".long_0042.vtu.tmp-999999-8"), "<VTKFile").unwrap();
+    std::fs::write(out.join("notes.tmp-1-2"), "the user's").unwrap();
+    assert!(std::fs::read_dir(&out).unwrap().count() > 5);
+    let short = write(&dir, "long.toml", &short());
+    let o = run_out(&short, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // left: the new run's files (those summary.json lists and the others it writes) and the user's
+    let left: BTreeSet<String> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let mut want: BTreeSet<String> = [".stamp-lock", ".stamp-run", "history.csv", "long.pvd", "notes.tmp-1-2", "summary.json"].iter().map(|s| s.to_string()).collect();
+    for step in summary(&out)["steps"].as_array().unwrap() {
+        want.insert(step["vtu"].as_str().unwrap().to_string());
+        want.extend(step["csv"].as_array().unwrap().iter().map(|c| c.as_str().unwrap().to_string()));
+    }
+    assert_eq!(left, want);
+}
+
+/// A tmpfs of `size` mounted on a fresh folder, unmounted when dropped (mounting needs root, which
+/// the project's machines and CI are).
+struct SmallDisk(std::path::PathBuf);
+
+impl SmallDisk {
+    fn mount(name: &str, size: &str) -> SmallDisk {
+        let dir = temp_dir(name);
+        let o = Command::new("mount").args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"]).arg(&dir).output().unwrap();
+        assert!(o.status.success(), "this test needs root to mount a small tmpfs: {}", String::from_utf8_lossy(&o.stderr));
+        SmallDisk(dir)
+    }
+}
+
+impl Drop for SmallDisk {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
+
+#[test]
+fn a_full_disk_never_leaves_summary_json_saying_running() {
+    let problem = repo().join("meshes/sphere-clamped.toml");
+    let mut ended_failed = 0;
+    for size in ["40k", "48k", "64k", "96k", "128k"] {
+        let disk = SmallDisk::mount(&format!("full-{size}"), size);
+        let out = disk.0.join("out");
+        let o = run_out(&problem, &out);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains("No space left on device") && !err.contains("panicked"), "{size}: {err}");
+        match std::fs::read_to_string(out.join("summary.json")) {
+            // refused before the run (no room for its summary), or summary.json removed
+            Err(_) => assert!(err.contains("cannot set aside") || err.contains("was removed"), "{size}: {err}"),
+            Ok(text) => {
+                let s: serde_json::Value = serde_json::from_str(&text).unwrap();
+                assert_eq!(s["status"], "failed", "{size}: {err}");
+                assert!(s["error"].as_str().unwrap().contains("No space left on device"), "{size}");
+                ended_failed += 1;
+            }
+        }
+        assert!(!out.join(".stamp-reserve").exists(), "{size}");
+    }
+    assert!(ended_failed >= 2, "the disks were not filled during the runs");
 }

@@ -57,7 +57,7 @@ fn listing(dir: &Path) -> Result<BTreeMap<OsString, Option<SystemTime>>> {
     for entry in std::fs::read_dir(dir).map_err(|e| StampError::io(dir, e))? {
         let entry = entry.map_err(|e| StampError::io(dir, e))?;
         let Ok(meta) = entry.metadata() else { continue };
-        if meta.is_file() && entry.file_name() != MANIFEST && entry.file_name() != LOCK_FILE {
+        if meta.is_file() && entry.file_name() != MANIFEST && entry.file_name() != LOCK_FILE && entry.file_name() != super::reserve::RESERVE {
             out.insert(entry.file_name(), meta.modified().ok());
         }
     }
@@ -120,6 +120,7 @@ impl RunFolder {
             refuse_non_regular(&dir.join(name))?;
         }
         let mut removed = remove_previous_outputs(dir, true)?;
+        removed.extend(remove_temporaries(dir)?);
         removed.extend(remove_refined_runs(dir)?);
         let before = listing(dir)?;
         let manifest = Manifest { status: "running".into(), written: Vec::new(), before: before.keys().filter_map(|k| k.to_str().map(String::from)).collect() };
@@ -174,6 +175,32 @@ fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {
     Ok(removed)
 }
 
+/// Whether `name` is that of a temporary file of [`stamp::io::write_atomically`]:
+/// `.<name>.tmp-<pid>-<n>`.
+fn is_temporary(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.') else { return false };
+    let Some((_, tail)) = rest.rsplit_once(".tmp-") else { return false };
+    let mut parts = tail.split('-');
+    let digits = |p: Option<&str>| p.is_some_and(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()));
+    digits(parts.next()) && digits(parts.next()) && parts.next().is_none()
+}
+
+/// Removes the temporary files a killed run left in `dir` (regular files named like those of
+/// [`stamp::io::write_atomically`]): with the folder locked, no other run is writing them.
+fn remove_temporaries(dir: &Path) -> Result<Vec<String>> {
+    let mut removed = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(|e| StampError::io(dir, e))? {
+        let entry = entry.map_err(|e| StampError::io(dir, e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let regular = entry.file_type().map(|t| t.is_file()).unwrap_or(false);
+        if regular && is_temporary(&name) {
+            std::fs::remove_file(entry.path()).map_err(|e| StampError::io(entry.path(), e))?;
+            removed.push(name);
+        }
+    }
+    Ok(removed)
+}
+
 /// Removes the finer runs a `stamp run --refine` left in `dir` (`refined/`, `refined2/`, ...:
 /// sub-folders with a manifest): their files, their manifest, and the folder when nothing else is
 /// in it. A later run without `--refine` (or with fewer levels) would otherwise leave results of
@@ -192,7 +219,7 @@ fn remove_refined_runs(dir: &Path) -> Result<Vec<String>> {
         }
         // refused while a run writes into it
         let lock = FolderLock::acquire(&sub)?;
-        removed.extend(remove_previous_outputs(&sub, false)?.into_iter().map(|f| format!("{name}/{f}")));
+        removed.extend(remove_previous_outputs(&sub, false)?.into_iter().chain(remove_temporaries(&sub)?).map(|f| format!("{name}/{f}")));
         std::fs::remove_file(sub.join(MANIFEST)).map_err(|e| StampError::io(&sub.join(MANIFEST), e))?;
         let _ = std::fs::remove_file(sub.join(LOCK_FILE));
         drop(lock);
@@ -291,6 +318,16 @@ mod tests {
         assert_eq!(f.removed, ["a_0001.vtu", "summary.json"]);
         drop(f);
         assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "later.txt", "notes.txt"]);
+    }
+
+    #[test]
+    fn temporary_files_are_told_from_the_users() {
+        for name in [".summary.json.tmp-123-0", ".p_0001.vtu.tmp-4-17", ".a.tmp-b.tmp-1-2"] {
+            assert!(is_temporary(name), "{name}");
+        }
+        for name in ["summary.json.tmp-123-0", ".x.tmp-1", ".x.tmp-1-2-3", ".x.tmp-a-2", ".x.tmp--2", "notes.txt"] {
+            assert!(!is_temporary(name), "{name}");
+        }
     }
 
     #[test]

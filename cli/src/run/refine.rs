@@ -160,10 +160,11 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
             Err(e) => {
                 let e = StampError::Problem(format!("{}: the mesh refined {} (results in {}): {e}", p.path.display(), times(level), dir.display()));
                 let message = e.to_string();
+                let status = if super::interrupt::received().is_some() { "interrupted" } else { "failed" };
                 edit_summary(&out_dir, |v| {
-                    v["status"] = json!("failed");
+                    v["status"] = json!(status);
                     v["error"] = json!(message);
-                    v["refinement"] = refinement(format!("failed: the mesh refined {}", times(level)), &meshes);
+                    v["refinement"] = refinement(format!("{status}: the mesh refined {}", times(level)), &meshes);
                 })?;
                 return Err(e);
             }

@@ -135,11 +135,11 @@ pub fn rfc3339_utc(time: std::time::SystemTime) -> String {
     format!("{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem % 3600 / 60, rem % 60)
 }
 
-/// Write summary.json; an error says that it was summary.json that could not be written, and
-/// what had gone wrong before (`earlier`), if anything.
-fn write_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>) -> Result<()> {
+/// Write summary.json and return its size; an error says that it was summary.json that could not
+/// be written, and what had gone wrong before (`earlier`), if anything.
+fn write_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>) -> Result<usize> {
     let text = serde_json::to_string_pretty(summary).map_err(json_err)?;
-    write_string_atomically(path, &text).map_err(|e| {
+    write_string_atomically(path, &text).map(|()| text.len()).map_err(|e| {
         let kind = match &e {
             StampError::Io { source, .. } => source.kind(),
             _ => std::io::ErrorKind::Other,
@@ -153,6 +153,31 @@ fn write_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>) -
             None => format!("cannot write summary.json: {cause}"),
         };
         StampError::Io { path: path.display().to_string(), source: std::io::Error::new(kind, message) }
+    })
+}
+
+/// Write the final summary.json: as usual; if that fails (a full disk), again once the reserve
+/// ([`super::reserve`]) gave its space back; if that fails too, the summary.json of the run so far
+/// (which says "running") is removed, so that none says what is no longer true, and a compact one
+/// is tried in its place. The error, if any, says what became of summary.json.
+fn write_final_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>, reserve: &mut super::reserve::Reserve) -> Result<()> {
+    let first = match write_summary(path, summary, earlier) {
+        Ok(_) => return Ok(()),
+        Err(e) => e,
+    };
+    if reserve.release() && write_summary(path, summary, earlier).is_ok() {
+        return Ok(());
+    }
+    let removed = std::fs::remove_file(path).is_ok();
+    if let Ok(text) = serde_json::to_string(summary) {
+        if write_string_atomically(path, &text).is_ok() {
+            return Ok(());
+        }
+    }
+    let tail = if removed { "; the summary.json of the run so far (status \"running\") was removed" } else { "" };
+    Err(match first {
+        StampError::Io { path, source } => StampError::Io { path, source: std::io::Error::new(source.kind(), format!("{source}{tail}")) },
+        e => StampError::Problem(format!("{e}{tail}")),
     })
 }
 
@@ -338,8 +363,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut write_error: Option<StampError> = None;
     let mut total_iterations = 0;
     let mut total_failed = 0;
+    // room for the final summary.json, whatever fills the disk meanwhile
+    let mut reserve = super::reserve::Reserve::create(out_dir)?;
     // a reader sees "running" (with our pid) from the start
-    write_summary(&summary_path, &summary, None)?;
+    reserve.cover(write_summary(&summary_path, &summary, None)?);
 
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
@@ -357,12 +384,14 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         }
         super::coarse::predict_from(&mut newton, path);
         summary.coarse_predictor = Some(report);
-        write_summary(&summary_path, &summary, None)?;
+        reserve.cover(write_summary(&summary_path, &summary, None)?);
     }
     newton.on_iteration = progress.callback();
     // a failed output write ends the run after its step (what follows could not be written)
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     newton.stop = Some(stop.clone());
+    // Ctrl-C and SIGTERM abandon the step in progress (see interrupt.rs)
+    newton.interrupt = super::interrupt::install();
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let mut surface_error: Option<StampError> = None;
@@ -448,7 +477,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             summary.failed_iterations = total_failed;
             summary.seconds = start.elapsed().as_secs_f64();
             // a failed write here is retried at the end (with the failure)
-            write_summary(&summary_path, &summary, None)
+            write_summary(&summary_path, &summary, None).map(|bytes| reserve.cover(bytes))
         });
         match step_result {
             Ok(()) => {
@@ -477,7 +506,9 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     // after a write failure the solve stopped on request: that is no failure of its own
     let surface_error = surface_error.or_else(|| surface_failure(p, &model.contacts));
     let solve_failure = if write_error.is_some() { None } else { surface_error.or(result.err()) };
-    if let Some(e) = &solve_failure {
+    let interrupted = matches!(solve_failure, Some(StampError::Interrupted { .. }));
+    // an interrupted step is no failed step: summary.json lists the written steps only
+    if let Some(e) = solve_failure.as_ref().filter(|_| !interrupted) {
         let lf = match e {
             StampError::NoConvergence { load_factor, .. } => Some(*load_factor),
             _ => None,
@@ -516,12 +547,18 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     match &failure {
         None if opts.caller_finishes => {}
         None => summary.status = "converged".into(),
+        Some(e @ StampError::Interrupted { .. }) => {
+            summary.status = "interrupted".into();
+            let by = super::interrupt::received().map(|s| format!("interrupted by {}", super::interrupt::name(s))).unwrap_or_else(|| "interrupted".into());
+            summary.error = Some(e.to_string().replacen("interrupted", &by, 1));
+        }
         Some(e) => {
             summary.status = "failed".into();
             summary.error = Some(e.to_string());
         }
     }
-    write_summary(&summary_path, &summary, failure.as_ref())?;
+    write_final_summary(&summary_path, &summary, failure.as_ref(), &mut reserve)?;
+    drop(reserve);
     files.push(summary_path.clone());
     let converged_steps = summary.steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).count();
     match failure {
