@@ -1,5 +1,6 @@
 //! A run against what happens around it: a second run into its folder, signals, kill -9, files of
-//! the folder that are not regular files, input files in the output folder.
+//! the folder that are not regular files, input files in the output folder, a full disk, a limit
+//! on the address space.
 
 mod common;
 use common::*;
@@ -266,4 +267,42 @@ fn a_full_disk_never_leaves_summary_json_saying_running() {
         assert!(!out.join(".stamp-reserve").exists(), "{size}");
     }
     assert!(ended_failed >= 2, "the disks were not filled during the runs");
+}
+
+/// `stamp` with these arguments under an address-space limit (`ulimit -v`) of `kib` KiB.
+fn under_ulimit_v(kib: u64, args: &[&std::ffi::OsStr]) -> Output {
+    Command::new("sh").arg("-c").arg(format!("ulimit -v {kib} && exec \"$0\" \"$@\"")).arg(env!("CARGO_BIN_EXE_stamp")).args(args).output().unwrap()
+}
+
+#[test]
+fn a_model_beyond_the_address_space_limit_is_refused_before_the_solve() {
+    // the sphere-displacement plate on 100 x 100 cells: about 0.37 GiB, under a limit of 0.7 GiB
+    // (0.2 GiB once the threads' stacks and heaps are set aside)
+    let p = variant("ulimit", "sphere-ss-displacement.toml", &[("n = [10, 10]", "n = [100, 100]")]);
+    let out = p.parent().unwrap().join("out");
+    let o = under_ulimit_v(700 * 1024, &["run".as_ref(), "-q".as_ref(), "--out".as_ref(), out.as_os_str(), p.as_os_str()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("mesh.rectangle") && err.contains("ulimit -v") && err.contains("0.37 GiB") && !err.contains("allocation"), "{err}");
+    assert!(!out.join("summary.json").exists(), "refused before anything is written");
+    // the same limit with enough room: solved
+    let small = variant("ulimit-small", "sphere-ss-displacement.toml", &[]);
+    let out = small.parent().unwrap().join("out");
+    let o = under_ulimit_v(700 * 1024, &["run".as_ref(), "-q".as_ref(), "--out".as_ref(), out.as_os_str(), small.as_os_str()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn an_stl_die_counts_in_the_memory_estimate() {
+    // a binary STL of 400 000 facets (20 MB): about 0.15 GiB once read; the model itself 0.06 GiB.
+    // Under a limit that leaves 0.15 GiB it is refused before it is read.
+    let p = variant("stl-memory", "stl-die.toml", &[("file = \"stl-die.stl\"", "file = \"big.stl\"")]);
+    let n: u32 = 400_000;
+    let mut bytes = vec![0u8; 84 + 50 * n as usize];
+    bytes[80..84].copy_from_slice(&n.to_le_bytes());
+    std::fs::write(p.parent().unwrap().join("big.stl"), &bytes).unwrap();
+    let o = under_ulimit_v((512 + 150) * 1024, &["check".as_ref(), p.as_os_str()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("STL die big.stl 0.15 GiB") && err.contains("ulimit -v"), "{err}");
 }
