@@ -163,7 +163,15 @@ pub struct NewtonSettings {
     /// iterations at n = 10 / 20 / 40 became 40 / 49 / 51 (1e-5: 40 / 51 / 52), the reactions of
     /// every step the same to 2e-8 relative (docs/performance.md).
     pub multiplier_tol: f64,
+    /// Most converged load steps of a path (`usize::MAX`: no limit). The path also stops as soon
+    /// as the pace of the last [`PACE_WINDOW`] steps (their mean increment) would need more steps
+    /// than are left to finish it: a path that crawls (ever smaller increments that converge)
+    /// ends with the reason instead of running for hours.
+    pub max_steps: usize,
 }
+
+/// The steps over which [`NewtonSettings::max_steps`] measures the pace of a path.
+pub const PACE_WINDOW: usize = 50;
 
 /// Iterations in a row with a changing active set that count as cycling.
 pub const CYCLING_WINDOW: usize = 6;
@@ -191,6 +199,7 @@ impl Default for NewtonSettings {
             cycling_after: 0,
             chord_tol: 1e-6,
             multiplier_tol: 1e-3,
+            max_steps: usize::MAX,
         }
     }
 }
@@ -322,6 +331,30 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     /// reported).
     pub fn iterations_done(&self) -> usize {
         self.iterations_done
+    }
+
+    /// Why the path must stop after `steps` converged steps with `remaining` load path left to go
+    /// ([`NewtonSettings::max_steps`]); `recent`: the load factors of the last steps.
+    fn over_budget(&self, steps: usize, recent: &std::collections::VecDeque<f64>, remaining: f64) -> Option<String> {
+        let max = self.settings.max_steps;
+        if remaining <= 0.0 || max == usize::MAX {
+            return None;
+        }
+        if steps >= max {
+            return Some(format!("max_steps = {max} steps converged with {remaining:.3e} of the load path still to go"));
+        }
+        let window = recent.len() - 1;
+        if window < PACE_WINDOW {
+            return None;
+        }
+        let pace = (recent[window] - recent[0]).abs() / window as f64;
+        let needed = remaining / pace;
+        (needed > (max - steps) as f64).then(|| {
+            format!(
+                "the path crawls: its last {window} steps took increments of {pace:.2e} on average; at that pace the {remaining:.3e} of the load path still to go \
+                 needs about {needed:.3e} more steps, beyond max_steps = {max} (a mesh of extreme cell aspect ratio, a stiff contact: see `stamp check`)"
+            )
+        })
     }
 
     /// Whether [`interrupt`](Self::interrupt) was set.
@@ -541,6 +574,11 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     }
 }
 
+/// The length of the path through `targets` in turn from the first: sum |t_{k+1} - t_k|.
+fn path_length(targets: &[f64]) -> f64 {
+    targets.windows(2).map(|w| (w[1] - w[0]).abs()).sum()
+}
+
 impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
     fn solve_path<P: NonlinearProblem>(
         &mut self,
@@ -563,6 +601,8 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         let mut peak_energy = 0.0f64;
         let first_span = targets.first().map(|&x| (x - t0).abs()).unwrap_or(1.0);
         let mut dt = (self.settings.initial_increment * first_span).min(self.settings.max_increment);
+        // the load factors of the last PACE_WINDOW converged steps (and the start), for max_steps
+        let mut recent: std::collections::VecDeque<f64> = std::collections::VecDeque::from([t0]);
         p.checkpoint();
         for (ti, &target) in targets.iter().enumerate() {
             if !target.is_finite() {
@@ -659,6 +699,14 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             target_index: is_target.then_some(ti),
                         };
                         on_step(&report, u, p);
+                        recent.push_back(t);
+                        if recent.len() > PACE_WINDOW + 1 {
+                            recent.pop_front();
+                        }
+                        if let Some(reason) = self.over_budget(summary.steps, &recent, (target - t).abs() + path_length(&targets[ti..])) {
+                            summary.seconds = start.elapsed().as_secs_f64();
+                            return Err(StampError::StepLimit { steps: summary.steps, load_factor: t, reason });
+                        }
                         if self.stop.as_ref().is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed)) {
                             summary.seconds = start.elapsed().as_secs_f64();
                             return Err(StampError::Problem(format!("stopped on request after load step {} (load factor {t:.6e})", summary.steps)));
@@ -883,6 +931,24 @@ mod tests {
         assert!(msg.contains("still violated") && msg.contains("after 3 augmented-Lagrangian updates"), "{msg}");
         // two attempts (one cut-back), each with 1 + 3 solves asking end_step
         assert_eq!(p.restarts, 8);
+    }
+
+    #[test]
+    fn a_path_is_stopped_by_its_step_budget_or_its_pace() {
+        // increments of 1e-3 towards 1: the pace of the first 50 steps needs 950 more, beyond 100
+        let s = NewtonSettings { max_increment: 1e-3, min_increment: 1e-4, max_steps: 100, ..settings() };
+        let (mut p, mut u, mut steps) = (Line::new(), [0.0], 0);
+        let e = NewtonRaphson::new(SparseLu::new(), s.clone()).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| steps += 1).unwrap_err();
+        assert!(matches!(e, StampError::StepLimit { steps: 50, .. }) && e.to_string().contains("crawls"), "{e}");
+        assert_eq!(steps, 50);
+        assert!((u[0] - 0.05).abs() < 1e-9, "{u:?}");
+        // the budget itself: 20 steps of the 30 a path of 0.03 needs
+        let (mut p, mut u) = (Line::new(), [0.0]);
+        let e = NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_steps: 20, ..s.clone() }).solve_path(&mut p, &mut u, 0.0, &[0.03], &mut |_, _, _| {}).unwrap_err();
+        assert!(matches!(e, StampError::StepLimit { steps: 20, .. }) && e.to_string().contains("max_steps = 20 steps converged"), "{e}");
+        // a path that fits is not stopped
+        let (mut p, mut u) = (Line::new(), [0.0]);
+        NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_steps: 30, ..s }).solve_path(&mut p, &mut u, 0.0, &[0.03], &mut |_, _, _| {}).unwrap();
     }
 
     #[test]

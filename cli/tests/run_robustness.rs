@@ -1,6 +1,6 @@
 //! A run against what happens around it: a second run into its folder, signals, kill -9, files of
 //! the folder that are not regular files, input files in the output folder, a full disk, a limit
-//! on the address space.
+//! on the address space, a load path that crawls.
 
 mod common;
 use common::*;
@@ -305,4 +305,46 @@ fn an_stl_die_counts_in_the_memory_estimate() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("STL die big.stl 0.15 GiB") && err.contains("ulimit -v"), "{err}");
+}
+
+#[test]
+fn a_path_that_crawls_stops_with_the_reason_and_is_warned_about() {
+    // cells 2 wide and 1e5 long: Newton needs increments of about 1e-4 of the load, step after step
+    let p = variant("crawl", "sphere-ss-displacement.toml", &[("y = [0.0, 20.0], n = [10, 10]", "y = [0.0, 1e6], n = [10, 10]")]);
+    let o = stamp().arg("check").arg(&p).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && err.contains("mesh.rectangle: 100 of 100 cells have an aspect ratio above 1000 (the worst 5.000e4"), "{err}");
+    let out = p.parent().unwrap().join("out");
+    let t0 = Instant::now();
+    let o = run_within(&p, &out, 120);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let s = summary(&out);
+    assert_eq!(s["status"], "failed");
+    let e = s["error"].as_str().unwrap();
+    assert!(e.contains("the path crawls") && e.contains("max_steps = 1000"), "{e}");
+    // stopped after a converged (and written) step: every step listed converged
+    let steps = s["steps"].as_array().unwrap();
+    assert!(steps.len() >= 50 && steps.iter().all(|e| e["converged"] == true), "{}", steps.len());
+    assert!(t0.elapsed() < Duration::from_secs(100));
+}
+
+#[test]
+fn max_steps_bounds_the_path_and_cannot_be_fewer_than_it_needs() {
+    // 4 targets at increments growing from 1e-3 of the first: far more than 6 steps
+    let text = short().replace("steps = 2", "targets = [0.25, 0.5, 0.75, 1.0]\ninitial_increment = 0.001\nmax_steps = 6");
+    let dir = temp_dir("max-steps");
+    let p = write(&dir, "p.toml", &text);
+    let out = dir.join("out");
+    let o = run_out(&p, &out);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = summary(&out);
+    assert_eq!(s["status"], "failed");
+    assert!(s["error"].as_str().unwrap().contains("max_steps = 6 steps converged"), "{}", s["error"]);
+    assert_eq!(s["steps"].as_array().unwrap().len(), 6);
+    // fewer than the 4 targets: refused where it is written
+    let p = write(&dir, "q.toml", &text.replace("max_steps = 6", "max_steps = 3"));
+    let o = stamp().arg("check").arg(&p).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("solver.max_steps: 3 is fewer than the 4 steps the path needs"), "{err}");
 }

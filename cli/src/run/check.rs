@@ -13,8 +13,8 @@
 //!   at the points closest to it (its travel is an unknown: it comes down onto them).
 //!
 //! Warnings (the solve goes on): a punch whose motion or force moves it away from its contact face;
-//! a punch on the side of the plate away from its contact face; after a run, a punch that never
-//! touched the plate ([`never_touched`]).
+//! a punch on the side of the plate away from its contact face; cells of extreme aspect ratio
+//! ([`super::cell_shape`]); after a run, a punch that never touched the plate ([`never_touched`]).
 
 use super::build::Setup;
 use super::mesh::MeshData;
@@ -64,7 +64,8 @@ pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
         starts.push(punch_start(p, setup, i, size)?);
     }
     let rigid = check_rigid_modes(p, setup, &starts, size)?;
-    let warnings = punch_warnings(p, setup, &starts);
+    let mut warnings = punch_warnings(p, setup, &starts);
+    warnings.extend(super::cell_shape::aspect_warning(p, &setup.mesh));
     let summary = summary(p, setup, &starts, &rigid);
     Ok(CheckReport { summary, warnings, punches: starts })
 }

@@ -14,6 +14,7 @@
 //! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in [`crate::paper`]).
 
 pub mod build;
+pub mod cell_shape;
 pub mod coarse;
 pub mod folder_lock;
 pub mod check;

@@ -273,6 +273,12 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let _folder = super::out_dir::RunFolder::claim(out_dir)?;
     let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
     let targets = opts.targets.clone().unwrap_or(targets);
+    // the step budget of the path (a refined run passes through the targets it is given)
+    let mut settings = settings;
+    settings.max_steps = match &opts.targets {
+        Some(t) => p.max_steps().max(super::problem::limits::STEP_BUDGET_FACTOR.saturating_mul(t.len())),
+        None => p.max_steps(),
+    };
     let out = &p.spec.output;
     let stem = p.path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "step".into());
     let path_end = targets.iter().fold((0.0, 0.0), |(len, last), &t| (len + (t - last).abs(), t)).0.max(f64::MIN_POSITIVE);
@@ -378,6 +384,8 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         if !quiet {
             eprintln!("coarse predictor: solving on the coarse mesh ({} nodes) first", coarse.setup.mesh.mesh.num_nodes());
         }
+        let mut coarse = coarse;
+        coarse.setup.settings.max_steps = newton.settings.max_steps;
         let (path, report) = super::coarse::solve_coarse(*coarse, &targets);
         if !quiet || report.error.is_some() {
             eprintln!("{}", report.line());
@@ -506,9 +514,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     // after a write failure the solve stopped on request: that is no failure of its own
     let surface_error = surface_error.or_else(|| surface_failure(p, &model.contacts));
     let solve_failure = if write_error.is_some() { None } else { surface_error.or(result.err()) };
-    let interrupted = matches!(solve_failure, Some(StampError::Interrupted { .. }));
-    // an interrupted step is no failed step: summary.json lists the written steps only
-    if let Some(e) = solve_failure.as_ref().filter(|_| !interrupted) {
+    // an interrupted step is no failed step, nor is a path stopped after a converged step for its
+    // step budget (the error says why): summary.json lists the written steps only
+    let no_failed_step = matches!(solve_failure, Some(StampError::Interrupted { .. } | StampError::StepLimit { .. }));
+    if let Some(e) = solve_failure.as_ref().filter(|_| !no_failed_step) {
         let lf = match e {
             StampError::NoConvergence { load_factor, .. } => Some(*load_factor),
             _ => None,
