@@ -66,6 +66,20 @@ fn start(problem: &Path, out: &Path) -> Child {
     }
 }
 
+/// Wait at most `secs` seconds for `child` to end (killing it and failing after that).
+fn finish(mut child: Child, secs: u64) -> Output {
+    let t0 = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > Duration::from_secs(secs) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("stamp run did not end within {secs} s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
 fn kill(child: &Child, signal: &str) {
     let ok = Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap().success();
     assert!(ok, "kill {signal} failed");
@@ -179,7 +193,7 @@ fn ctrl_c_and_sigterm_end_a_run_cleanly_with_the_steps_written() {
         let p = write(&dir, "p.toml", &long_listing_steps());
         let child = start(&p, &out);
         kill(&child, signal);
-        let o = child.wait_with_output().unwrap();
+        let o = finish(child, 60);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(status), "{signal}: {err}");
         assert!(err.contains("interrupted") && !err.contains("panicked"), "{signal}: {err}");
@@ -347,4 +361,26 @@ fn max_steps_bounds_the_path_and_cannot_be_fewer_than_it_needs() {
     let o = stamp().arg("check").arg(&p).output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("solver.max_steps: 3 is fewer than the 4 steps the path needs"), "{err}");
+}
+
+#[test]
+fn an_abort_leaves_summary_json_saying_failed_not_running() {
+    // SIGABRT is what an allocation that fails ends the process with
+    let dir = temp_dir("abort");
+    let out = dir.join("out");
+    let p = write(&dir, "p.toml", &long_listing_steps());
+    let child = start(&p, &out);
+    kill(&child, "-ABRT");
+    let o = finish(child, 60);
+    assert!(!o.status.success());
+    let s = summary(&out);
+    assert_eq!(s["status"], "failed");
+    assert!(s["error"].as_str().unwrap().contains("the process aborted (SIGABRT)"), "{}", s["error"]);
+    let steps = s["steps"].as_array().unwrap();
+    assert!(!steps.is_empty() && steps.iter().all(|e| e["converged"] == true));
+    assert!(steps.len() <= history_rows(&out));
+    // the next run into the folder is let in and cleans up
+    let o = run_out(&write(&dir, "p.toml", &short()), &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.join(".stamp-reserve").exists());
 }

@@ -13,6 +13,7 @@
 //!   [`refine_report`] (the estimates in the table, history.csv and summary.json);
 //! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in [`crate::paper`]).
 
+pub mod abort_note;
 pub mod build;
 pub mod cell_shape;
 pub mod coarse;

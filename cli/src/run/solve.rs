@@ -181,6 +181,18 @@ fn write_final_summary(path: &Path, summary: &Summary, earlier: Option<&StampErr
     })
 }
 
+/// summary.json as it would be if the process aborted now: "failed", with the steps listed so far.
+fn aborted(summary: &Summary) -> String {
+    let mut v = serde_json::to_value(summary).unwrap_or_default();
+    let steps = summary.steps.len();
+    v["status"] = "failed".into();
+    v["error"] = format!(
+        "the process aborted (SIGABRT) after the {steps} steps listed here were written: most likely an allocation failed (out of memory), see stderr"
+    )
+    .into();
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
 /// The progress bar: the load path along the bar, Newton iteration and residual in the message.
 /// Without a terminal (and without --quiet) one terse line per converged step on stderr.
 struct Progress {
@@ -373,6 +385,9 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut reserve = super::reserve::Reserve::create(out_dir)?;
     // a reader sees "running" (with our pid) from the start
     reserve.cover(write_summary(&summary_path, &summary, None)?);
+    // what summary.json says if the process aborts from here on (see abort_note.rs)
+    let abort_note = super::abort_note::AbortNote::new();
+    abort_note.prepare(&summary_path, aborted(&summary));
 
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
@@ -393,6 +408,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         super::coarse::predict_from(&mut newton, path);
         summary.coarse_predictor = Some(report);
         reserve.cover(write_summary(&summary_path, &summary, None)?);
+        abort_note.prepare(&summary_path, aborted(&summary));
     }
     newton.on_iteration = progress.callback();
     // a failed output write ends the run after its step (what follows could not be written)
@@ -485,7 +501,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             summary.failed_iterations = total_failed;
             summary.seconds = start.elapsed().as_secs_f64();
             // a failed write here is retried at the end (with the failure)
-            write_summary(&summary_path, &summary, None).map(|bytes| reserve.cover(bytes))
+            write_summary(&summary_path, &summary, None).map(|bytes| {
+                reserve.cover(bytes);
+                abort_note.prepare(&summary_path, aborted(&summary));
+            })
         });
         match step_result {
             Ok(()) => {
@@ -566,6 +585,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             summary.error = Some(e.to_string());
         }
     }
+    abort_note.withdraw();
     write_final_summary(&summary_path, &summary, failure.as_ref(), &mut reserve)?;
     drop(reserve);
     files.push(summary_path.clone());
