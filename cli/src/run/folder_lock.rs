@@ -66,10 +66,8 @@ impl FolderLock {
                 let _ = file.read_to_string(&mut text);
                 let pid = text.trim();
                 let who = if pid.is_empty() || !pid.chars().all(|c| c.is_ascii_digit()) { "another process".to_string() } else { format!("process {pid}") };
-                return Err(StampError::Problem(format!(
-                    "{} is in use: another stamp run ({who}) is writing into it; wait for it to end, stop it, or choose another --out",
-                    dir.display()
-                )));
+                let message = format!("the folder is in use: another stamp run ({who}) is writing into it; wait for it to end, stop it, or choose another --out");
+                return Err(StampError::io(dir, std::io::Error::new(std::io::ErrorKind::WouldBlock, message)));
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(StampError::io(&path, e)),
         }

@@ -14,6 +14,10 @@
 //! pressure_*, probe_*, force_travel_* .csv/.png/.svg, history.csv). A folder written before manifests existed (summary.json without a
 //! manifest) loses what that summary.json names: summary.json, the steps' .vtu and .csv files,
 //! the .pvd and the punches' pressure plots.
+//!
+//! A claim first locks the folder ([`FolderLock`]: a second run is refused while the first lives),
+//! refuses a manifest or summary.json that is not a regular file ([`super::regular`]), and
+//! removes the temporary files (`.NAME.tmp-PID-N`) a killed run left in the middle of a write.
 
 use super::folder_lock::{FolderLock, LOCK_FILE};
 use super::regular::{read_regular, refuse_non_regular};

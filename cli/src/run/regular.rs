@@ -32,13 +32,16 @@ pub fn kind(meta: &Metadata) -> &'static str {
 /// file and what it is, and says what to do.
 pub fn refuse_non_regular(path: &Path) -> Result<()> {
     match std::fs::symlink_metadata(path) {
-        Ok(meta) if !meta.is_file() => Err(StampError::Problem(format!(
-            "{} is {}, not a regular file: stamp writes its own file of that name there; remove it or choose another --out",
-            path.display(),
-            kind(&meta)
-        ))),
+        Ok(meta) if !meta.is_file() => Err(not_regular(path, &meta)),
         _ => Ok(()),
     }
+}
+
+/// The error for `path`, which is not a regular file.
+fn not_regular(path: &Path, meta: &Metadata) -> StampError {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let message = format!("cannot write {name} there: it is {}, not a regular file; remove it or choose another --out", kind(meta));
+    StampError::io(path, std::io::Error::new(std::io::ErrorKind::InvalidInput, message))
 }
 
 /// The text of `path` if it is a regular file (not followed through a link, never waiting on a
@@ -54,7 +57,7 @@ pub fn read_regular(path: &Path) -> Result<Option<String>> {
     // checked again on the open file: it may have been replaced in between
     let meta = file.metadata().map_err(|e| StampError::io(path, e))?;
     if !meta.is_file() {
-        return Err(StampError::Problem(format!("{} is {}, not a regular file; remove it or choose another --out", path.display(), kind(&meta))));
+        return Err(not_regular(path, &meta));
     }
     let mut text = String::new();
     file.read_to_string(&mut text).map_err(|e| StampError::io(path, e))?;

@@ -281,6 +281,9 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
     super::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
+    // from here on Ctrl-C and SIGTERM abandon the step in progress (see interrupt.rs): a signal
+    // that comes before the solve ends it at its first iteration
+    let interrupt = super::interrupt::install();
     // removes the previous run's files; records this run's when dropped (see out_dir.rs)
     let _folder = super::out_dir::RunFolder::claim(out_dir)?;
     let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
@@ -414,8 +417,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     // a failed output write ends the run after its step (what follows could not be written)
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     newton.stop = Some(stop.clone());
-    // Ctrl-C and SIGTERM abandon the step in progress (see interrupt.rs)
-    newton.interrupt = super::interrupt::install();
+    newton.interrupt = interrupt;
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let mut surface_error: Option<StampError> = None;
