@@ -1,6 +1,6 @@
 //! Printing to stdout without panicking: `stamp check P.toml | head -1` closes the pipe early and
 //! `> /dev/full` fails every write, where `println!` would panic. [`outln!`](crate::outln) and
-//! [`out!`](crate::out) write through [`print`], which keeps the first failure and stops writing;
+//! [`out!`](crate::out) write through [`print()`], which keeps the first failure and stops writing;
 //! the program goes on (a run still writes its files and summary.json) and [`finish`] says at the
 //! end how it went: a broken pipe is not an error (the reader had what it wanted, as with other
 //! Unix tools), any other failure is.
@@ -31,13 +31,13 @@ pub fn finish() -> Result<(), std::io::Error> {
     }
 }
 
-/// `print!` to stdout through [`print`]: never panics.
+/// `print!` to stdout through [`print()`]: never panics.
 #[macro_export]
 macro_rules! out {
     ($($arg:tt)*) => { $crate::stdout::print(&format!($($arg)*)) };
 }
 
-/// `println!` to stdout through [`print`]: never panics.
+/// `println!` to stdout through [`print()`]: never panics.
 #[macro_export]
 macro_rules! outln {
     () => { $crate::stdout::print("\n") };

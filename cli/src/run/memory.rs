@@ -35,12 +35,12 @@ pub fn estimate_bytes(nodes: u64, dofs_per_node: u64) -> f64 {
 /// allocator's per-thread heaps, which are reserved whether used or not. Measured (VmPeak against
 /// VmHWM, `stamp run`, 2026-11-25, 2 threads): 210 MiB for a 14 MiB run, 300 and 370 MiB for the
 /// sphere-displacement plate at n = 100 and 200; below that `ulimit -v` aborts even small runs.
-const ADDRESS_SPACE_OVERHEAD: f64 = 512.0 * 1024.0 * 1024.0;
+pub const ADDRESS_SPACE_OVERHEAD: f64 = 512.0 * 1024.0 * 1024.0;
 
 /// Bytes of memory per facet of an STL die, besides the file's own bytes (read whole): the facet
 /// soup, the welded vertices and their normals, the R-tree. Measured: a binary STL of 1 598 000
 /// facets (80 MB) peaks at 610 MB in `stamp check` (2026-11-25), 330 bytes a facet beyond the file.
-const BYTES_PER_STL_FACET: f64 = 360.0;
+pub const BYTES_PER_STL_FACET: f64 = 360.0;
 /// The fewest bytes an ASCII STL spends on a facet (`facet normal`, `outer loop`, three
 /// `vertex` lines, `endloop`, `endfacet`, with the shortest numbers).
 const MIN_ASCII_FACET_BYTES: f64 = 90.0;
