@@ -34,7 +34,8 @@ fn allocate(file: &File, bytes: u64) -> std::io::Result<()> {
 }
 
 impl Reserve {
-    /// Hold [`MIN_BYTES`] in `dir`; refused when the folder does not have that much room.
+    /// Hold [`MIN_BYTES`] in `dir`; refused when the folder does not have that much room (a file
+    /// system that cannot allocate ahead gets no reserve).
     pub fn create(dir: &Path) -> Result<Reserve> {
         let path = dir.join(RESERVE);
         super::regular::refuse_non_regular(&path)?;
@@ -42,6 +43,10 @@ impl Reserve {
         if let Err(e) = allocate(&file, MIN_BYTES) {
             drop(file);
             let _ = std::fs::remove_file(&path);
+            // a file system that cannot allocate ahead: no reserve (only a full one is refused)
+            if !matches!(e.raw_os_error(), Some(libc::ENOSPC) | Some(libc::EDQUOT)) {
+                return Ok(Reserve { path, file: None, bytes: 0 });
+            }
             let message = format!("cannot set aside {} KiB for the run's summary.json: {e}; free some space or choose another --out", MIN_BYTES / 1024);
             return Err(StampError::io(dir, std::io::Error::new(e.kind(), message)));
         }
