@@ -45,6 +45,14 @@ pub enum StampError {
         tolerance: f64,
         reason: String,
     },
+    /// The solve was interrupted on request (a signal): the step in progress was abandoned, the
+    /// state is that of the last converged step.
+    #[error("interrupted after load step {steps} (load factor {load_factor:.6e}): the step in progress was abandoned")]
+    Interrupted { steps: usize, load_factor: f64 },
+    /// The load path was given up before its end: more steps than allowed, or a pace that would
+    /// need more ([`crate::nonlinear::NewtonSettings::max_steps`]).
+    #[error("the load path was stopped after load step {steps} (load factor {load_factor:.6e}): {reason}")]
+    StepLimit { steps: usize, load_factor: f64, reason: String },
     /// An I/O error with the path it concerns.
     #[error("{}: {source}", short_path(path))]
     Io {

@@ -163,7 +163,15 @@ pub struct NewtonSettings {
     /// iterations at n = 10 / 20 / 40 became 40 / 49 / 51 (1e-5: 40 / 51 / 52), the reactions of
     /// every step the same to 2e-8 relative (docs/performance.md).
     pub multiplier_tol: f64,
+    /// Most converged load steps of a path (`usize::MAX`: no limit). The path also stops as soon
+    /// as the pace of the last [`PACE_WINDOW`] steps (their mean increment) would need more steps
+    /// than are left to finish it: a path that crawls (ever smaller increments that converge)
+    /// ends with the reason instead of running for hours.
+    pub max_steps: usize,
 }
+
+/// The steps over which [`NewtonSettings::max_steps`] measures the pace of a path.
+pub const PACE_WINDOW: usize = 50;
 
 /// Iterations in a row with a changing active set that count as cycling.
 pub const CYCLING_WINDOW: usize = 6;
@@ -191,6 +199,7 @@ impl Default for NewtonSettings {
             cycling_after: 0,
             chord_tol: 1e-6,
             multiplier_tol: 1e-3,
+            max_steps: usize::MAX,
         }
     }
 }
@@ -297,6 +306,10 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// Set (by the step callback, say, after its output failed) to end the path after the current
     /// step: `solve_path` then returns [`StampError::Problem`] "stopped on request".
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Set (by a signal handler, say) to abandon the step in progress: checked before every
+    /// Newton iteration; `solve_path` then returns [`StampError::Interrupted`] with `u` at the
+    /// last converged state.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// The start of each load step, when given: called with (converged steps so far, load factor
     /// of the last converged state, load factor of the step, the start to set); true when it set
     /// the start (then used instead of the secant extrapolation, see
@@ -310,7 +323,7 @@ pub struct NewtonRaphson<L: LinearSolver> {
 
 impl<L: LinearSolver> NewtonRaphson<L> {
     pub fn new(linear: L, settings: NewtonSettings) -> Self {
-        NewtonRaphson { settings, linear, on_iteration: None, stop: None, predictor: None, iterations_done: 0 }
+        NewtonRaphson { settings, linear, on_iteration: None, stop: None, interrupt: None, predictor: None, iterations_done: 0 }
     }
 
     /// Newton iterations done so far by this solver, those of attempts that failed included (a
@@ -318,6 +331,35 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     /// reported).
     pub fn iterations_done(&self) -> usize {
         self.iterations_done
+    }
+
+    /// Why the path must stop after `steps` converged steps with `remaining` load path left to go
+    /// ([`NewtonSettings::max_steps`]); `recent`: the load factors of the last steps.
+    fn over_budget(&self, steps: usize, recent: &std::collections::VecDeque<f64>, remaining: f64) -> Option<String> {
+        let max = self.settings.max_steps;
+        if remaining <= 0.0 || max == usize::MAX {
+            return None;
+        }
+        if steps >= max {
+            return Some(format!("max_steps = {max} steps converged with {remaining:.3e} of the load path still to go"));
+        }
+        let window = recent.len() - 1;
+        if window < PACE_WINDOW {
+            return None;
+        }
+        let pace = (recent[window] - recent[0]).abs() / window as f64;
+        let needed = remaining / pace;
+        (needed > (max - steps) as f64).then(|| {
+            format!(
+                "the path crawls: its last {window} steps took increments of {pace:.2e} on average; at that pace the {remaining:.3e} of the load path still to go \
+                 needs about {needed:.3e} more steps, beyond max_steps = {max} (a mesh of extreme cell aspect ratio, a stiff contact: see `stamp check`)"
+            )
+        })
+    }
+
+    /// Whether [`interrupt`](Self::interrupt) was set.
+    fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
@@ -357,6 +399,9 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         for it in 0.. {
             if it > 0 {
                 self.iterations_done += 1;
+            }
+            if self.interrupted() {
+                return Err(("interrupted".into(), history.last().copied().unwrap_or(f64::NAN), *last_tol));
             }
             let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
@@ -529,6 +574,11 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     }
 }
 
+/// The length of the path through `targets` in turn from the first: sum |t_{k+1} - t_k|.
+fn path_length(targets: &[f64]) -> f64 {
+    targets.windows(2).map(|w| (w[1] - w[0]).abs()).sum()
+}
+
 impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
     fn solve_path<P: NonlinearProblem>(
         &mut self,
@@ -551,6 +601,8 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         let mut peak_energy = 0.0f64;
         let first_span = targets.first().map(|&x| (x - t0).abs()).unwrap_or(1.0);
         let mut dt = (self.settings.initial_increment * first_span).min(self.settings.max_increment);
+        // the load factors of the last PACE_WINDOW converged steps (and the start), for max_steps
+        let mut recent: std::collections::VecDeque<f64> = std::collections::VecDeque::from([t0]);
         p.checkpoint();
         for (ti, &target) in targets.iter().enumerate() {
             if !target.is_finite() {
@@ -561,6 +613,9 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
             // iterations of the attempts of this step that failed
             let mut failed_iterations = 0;
             while t != target {
+                if self.interrupted() {
+                    return Err(StampError::Interrupted { steps: summary.steps, load_factor: t });
+                }
                 let remaining = target - t;
                 let step_t = if dt >= remaining.abs() * (1.0 - 1e-12) { target } else { t + dt.copysign(remaining) };
                 if step_t == t || !step_t.is_finite() {
@@ -644,6 +699,14 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                             target_index: is_target.then_some(ti),
                         };
                         on_step(&report, u, p);
+                        recent.push_back(t);
+                        if recent.len() > PACE_WINDOW + 1 {
+                            recent.pop_front();
+                        }
+                        if let Some(reason) = self.over_budget(summary.steps, &recent, (target - t).abs() + path_length(&targets[ti..])) {
+                            summary.seconds = start.elapsed().as_secs_f64();
+                            return Err(StampError::StepLimit { steps: summary.steps, load_factor: t, reason });
+                        }
                         if self.stop.as_ref().is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed)) {
                             summary.seconds = start.elapsed().as_secs_f64();
                             return Err(StampError::Problem(format!("stopped on request after load step {} (load factor {t:.6e})", summary.steps)));
@@ -659,6 +722,9 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         failed_iterations += spent;
                         summary.failed_iterations += spent;
                         p.restore();
+                        if self.interrupted() {
+                            return Err(StampError::Interrupted { steps: summary.steps, load_factor: t });
+                        }
                         cutbacks_in_row += 1;
                         summary.cutbacks += 1;
                         dt = 0.5 * (step_t - t).abs();
@@ -865,6 +931,41 @@ mod tests {
         assert!(msg.contains("still violated") && msg.contains("after 3 augmented-Lagrangian updates"), "{msg}");
         // two attempts (one cut-back), each with 1 + 3 solves asking end_step
         assert_eq!(p.restarts, 8);
+    }
+
+    #[test]
+    fn a_path_is_stopped_by_its_step_budget_or_its_pace() {
+        // increments of 1e-3 towards 1: the pace of the first 50 steps needs 950 more, beyond 100
+        let s = NewtonSettings { max_increment: 1e-3, min_increment: 1e-4, max_steps: 100, ..settings() };
+        let (mut p, mut u, mut steps) = (Line::new(), [0.0], 0);
+        let e = NewtonRaphson::new(SparseLu::new(), s.clone()).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| steps += 1).unwrap_err();
+        assert!(matches!(e, StampError::StepLimit { steps: 50, .. }) && e.to_string().contains("crawls"), "{e}");
+        assert_eq!(steps, 50);
+        assert!((u[0] - 0.05).abs() < 1e-9, "{u:?}");
+        // the budget itself: 20 steps of the 30 a path of 0.03 needs
+        let (mut p, mut u) = (Line::new(), [0.0]);
+        let e = NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_steps: 20, ..s.clone() }).solve_path(&mut p, &mut u, 0.0, &[0.03], &mut |_, _, _| {}).unwrap_err();
+        assert!(matches!(e, StampError::StepLimit { steps: 20, .. }) && e.to_string().contains("max_steps = 20 steps converged"), "{e}");
+        // a path that fits is not stopped
+        let (mut p, mut u) = (Line::new(), [0.0]);
+        NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_steps: 30, ..s }).solve_path(&mut p, &mut u, 0.0, &[0.03], &mut |_, _, _| {}).unwrap();
+    }
+
+    #[test]
+    fn an_interrupt_abandons_the_step_in_progress() {
+        // set at the first Newton iteration of the first step
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let mut newton = NewtonRaphson::new(SparseLu::new(), settings());
+        newton.interrupt = Some(flag.clone());
+        let f = flag.clone();
+        newton.on_iteration = Some(Box::new(move |_, _, _| f.store(true, std::sync::atomic::Ordering::Relaxed)));
+        let mut steps = Vec::new();
+        let e = newton.solve_path(&mut p, &mut u, 0.0, &[0.25, 0.5], &mut |r, _, _| steps.push(r.load_factor)).unwrap_err();
+        assert!(matches!(e, StampError::Interrupted { steps: 0, load_factor: 0.0 }), "{e}");
+        assert!(steps.is_empty() && u[0] == 0.0, "{steps:?} {u:?}");
+        assert!(e.to_string().contains("interrupted after load step 0"), "{e}");
     }
 
     #[test]

@@ -383,11 +383,11 @@ pub fn bench_command(sizes: &[usize], json: bool, options: SolverOptions) -> Res
     if json {
         let runs = run_sizes(sizes, options, |_| {})?;
         let text = serde_json::to_string_pretty(&serde_json::json!({ "runs": runs })).map_err(|e| StampError::Problem(e.to_string()))?;
-        println!("{text}");
+        crate::outln!("{text}");
     } else {
-        println!("{}", header(options));
-        run_sizes(sizes, options, |r| println!("{}", row(r)))?;
-        println!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; cuts: load increments cut back, newton: iterations of the converged steps (/step: per step), coarse: Newton iterations of the coarse solve that started every step (predictor = \"coarse\", a quarter of the unknowns; its time is in total), factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), fthr: their threads (the first two measure faer's parallel setting against one thread; the faster is kept), gmres: GMRES iterations", rayon::current_num_threads());
+        crate::outln!("{}", header(options));
+        run_sizes(sizes, options, |r| crate::outln!("{}", row(r)))?;
+        crate::outln!("threads: {} (RAYON_NUM_THREADS); seconds are wall time per phase, summed over the solve; cuts: load increments cut back, newton: iterations of the converged steps (/step: per step), coarse: Newton iterations of the coarse solve that started every step (predictor = \"coarse\", a quarter of the unknowns; its time is in total), factors: numeric factorisations (--reuse: a factor serves later Newton iterations while that is cheaper), fthr: their threads (the first two measure faer's parallel setting against one thread; the faster is kept), gmres: GMRES iterations", rayon::current_num_threads());
     }
     Ok(())
 }
@@ -395,7 +395,7 @@ pub fn bench_command(sizes: &[usize], json: bool, options: SolverOptions) -> Res
 /// `stamp bench --one n`: one size, as one JSON object on stdout.
 pub fn one_command(n: usize, options: SolverOptions) -> Result<()> {
     let run = run_one(n, options)?;
-    println!("{}", serde_json::to_string(&run).map_err(|e| StampError::Problem(e.to_string()))?);
+    crate::outln!("{}", serde_json::to_string(&run).map_err(|e| StampError::Problem(e.to_string()))?);
     Ok(())
 }
 

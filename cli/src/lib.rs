@@ -2,3 +2,4 @@
 pub mod bench;
 pub mod paper;
 pub mod run;
+pub mod stdout;

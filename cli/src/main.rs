@@ -80,7 +80,21 @@ enum Command {
 
 fn main() -> ExitCode {
     // `--refine 2 P.toml` is read as `--refine=2 P.toml`, `--refine P.toml` as `--refine=1 P.toml`
-    let cli = Cli::parse_from(stamp_cli::run::refine::join_refine_value(std::env::args_os()));
+    let cli = match Cli::try_parse_from(stamp_cli::run::refine::join_refine_value(std::env::args_os())) {
+        Ok(cli) => cli,
+        // --help and --version: on stdout, through the printer that reports a failed write
+        Err(e) if !e.use_stderr() => {
+            stamp_cli::out!("{e}");
+            return match stamp_cli::stdout::finish() {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(w) => {
+                    eprintln!("error: cannot write to stdout: {w}");
+                    ExitCode::FAILURE
+                }
+            };
+        }
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         None => stamp_cli::paper::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
@@ -92,11 +106,22 @@ fn main() -> ExitCode {
             stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor })
         }
     };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
+    // a reader that closed stdout early is no error; a stdout that cannot be written (a full disk,
+    // /dev/full) is, once the command has done the rest of its work
+    let stdout = stamp_cli::stdout::finish();
+    match (result, stdout) {
+        (Ok(()), Ok(())) => ExitCode::SUCCESS,
+        (Ok(()), Err(e)) => {
+            eprintln!("error: cannot write to stdout: {e}");
             ExitCode::FAILURE
+        }
+        (Err(e), _) => {
+            eprintln!("error: {e}");
+            // ended by Ctrl-C or SIGTERM: the status a shell gives a process the signal ended
+            match stamp_cli::run::interrupt::received() {
+                Some(signal) => ExitCode::from(stamp_cli::run::interrupt::exit_status(signal)),
+                None => ExitCode::FAILURE,
+            }
         }
     }
 }

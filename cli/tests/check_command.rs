@@ -331,3 +331,32 @@ fn the_plate_line_names_the_model_choices() {
     let o = check(&repo().join("meshes/sphere-ss-displacement.toml"));
     assert!(o.stdout.contains("nu = 0.3, nonlinear\n"), "{}", o.stdout);
 }
+
+/// `stamp` with these arguments and stdout sent to `stdout`.
+fn with_stdout(args: &[&str], stdout: std::process::Stdio) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_stamp")).args(args).stdout(stdout).stderr(std::process::Stdio::piped()).output().unwrap()
+}
+
+#[test]
+fn a_stdout_closed_early_ends_quietly_and_a_full_one_is_an_error() {
+    let problem = repo().join("meshes/sphere-clamped.toml");
+    let problem = problem.to_str().unwrap();
+    let out = temp_dir("stdout-run").join("out");
+    let out = out.to_str().unwrap();
+    for args in [vec!["check", problem], vec!["--help"], vec!["run", "--out", out, problem]] {
+        // a reader that has gone (`| head -1` after its line): no panic, no message, success
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = with_stdout(&args, writer.into());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success() && !err.contains("panicked") && !err.contains("error"), "{args:?}: {:?} {err}", o.status);
+        // /dev/full: a clear error and a failure, without a panic
+        let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        let o = with_stdout(&args, full.into());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("error: cannot write to stdout: No space left on device") && !err.contains("panicked"), "{args:?}: {err}");
+    }
+    // the run wrote its files all the same, and says so truthfully
+    assert_eq!(summary(std::path::Path::new(out))["status"], "converged");
+}

@@ -69,7 +69,7 @@ fn a_rerun_leaves_only_its_own_files_and_the_users() {
     let short = dir.join("p.toml");
     std::fs::write(&short, problem(2, false)).unwrap();
     run(&short, &out);
-    let want = set(&[".stamp-run", "mine.vtu", "notes.txt", "summary.json", "p.pvd", "p_0001.vtu", "p_0002.vtu", "pressure_ball_0001.csv", "pressure_ball_0002.csv", "history.csv"]);
+    let want = set(&[".stamp-lock", ".stamp-run", "mine.vtu", "notes.txt", "summary.json", "p.pvd", "p_0001.vtu", "p_0002.vtu", "pressure_ball_0001.csv", "pressure_ball_0002.csv", "history.csv"]);
     assert_eq!(names(&out), want);
     assert_eq!(std::fs::read_to_string(out.join("mine.vtu")).unwrap(), "the user's");
     // the .pvd names the new run's steps only
@@ -80,7 +80,7 @@ fn a_rerun_leaves_only_its_own_files_and_the_users() {
     let other = dir.join("q.toml");
     std::fs::write(&other, problem(1, false)).unwrap();
     run(&other, &out);
-    assert_eq!(names(&out), set(&[".stamp-run", "mine.vtu", "notes.txt", "summary.json", "q.pvd", "q_0001.vtu", "pressure_ball_0001.csv", "history.csv"]));
+    assert_eq!(names(&out), set(&[".stamp-lock", ".stamp-run", "mine.vtu", "notes.txt", "summary.json", "q.pvd", "q_0001.vtu", "pressure_ball_0001.csv", "history.csv"]));
 }
 
 #[test]

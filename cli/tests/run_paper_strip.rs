@@ -81,10 +81,10 @@ fn paper_r100_reproduces_table2_last_row() {
         assert!(bytes.len() > 1000, "{f} is too small");
     }
     assert_eq!(&std::fs::read(out.join("probe_cylinder.png")).unwrap()[..4], b"\x89PNG");
-    // no temporary files left behind (the run's manifest of its files is not one)
+    // no temporary files left behind (the run's manifest of its files and its lock are not ones)
     for entry in std::fs::read_dir(&out).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
-        assert!(!name.starts_with('.') || name == stamp_cli::run::out_dir::MANIFEST, "temporary file {name} left");
+        assert!(!name.starts_with('.') || name == stamp_cli::run::out_dir::MANIFEST || name == stamp_cli::run::folder_lock::LOCK_FILE, "temporary file {name} left");
     }
 
     // an independent reader: VTK

@@ -24,9 +24,9 @@ pub fn figure4_written_message(dir: &Path) -> String {
 pub fn paper_command(json: bool, plot: Option<&Path>) -> stamp::Result<()> {
     let report = tables::run_paper()?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&report).map_err(|e| stamp::StampError::Problem(e.to_string()))?);
+        crate::outln!("{}", serde_json::to_string_pretty(&report).map_err(|e| stamp::StampError::Problem(e.to_string()))?);
     } else {
-        print!("{}", report::format_report(&report));
+        crate::out!("{}", report::format_report(&report));
     }
     if let Some(dir) = plot {
         figure4::write_figure4(dir)?;
@@ -34,7 +34,7 @@ pub fn paper_command(json: bool, plot: Option<&Path>) -> stamp::Result<()> {
         if json {
             eprintln!("{message}");
         } else {
-            println!("\n{message}");
+            crate::outln!("\n{message}");
         }
     }
     Ok(())

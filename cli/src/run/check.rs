@@ -24,8 +24,9 @@
 //! Warnings (the solve goes on): a punch whose motion or force moves it away from its contact face;
 //! a motion that carries a punch through the plate within an increment of `max_increment`
 //! ([`super::psi_checks::sweep_warning`]);
-//! a punch on the side of the plate away from its contact face; after a run, a punch that never
-//! touched the plate or touched it on a zone narrower than the cells ([`after_the_run`]).
+//! a punch on the side of the plate away from its contact face; cells of extreme aspect ratio
+//! ([`super::cell_shape`]); after a run, a punch that never touched the plate or touched it on a
+//! zone narrower than the cells ([`after_the_run`]).
 
 use super::build::Setup;
 use super::mesh::{where_node, MeshData};
@@ -77,7 +78,8 @@ pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
         starts.push(punch_start(p, setup, i, size)?);
     }
     let rigid = check_rigid_modes(p, setup, &starts, size)?;
-    let warnings = punch_warnings(p, setup, &starts);
+    let mut warnings = punch_warnings(p, setup, &starts);
+    warnings.extend(super::cell_shape::aspect_warning(p, &setup.mesh));
     let summary = summary(p, setup, &starts, &rigid);
     Ok(CheckReport { summary, warnings, punches: starts })
 }
@@ -408,7 +410,7 @@ fn punch_warnings(p: &Problem, setup: &Setup, starts: &[PunchStart]) -> Vec<Stri
 /// contact at any recorded step, and a punch whose loaded zone at the last step is narrower than
 /// the cells (see [`super::output::narrower_than_cells`]).
 pub fn after_the_run(p: &Problem, summary: &Path) -> Vec<String> {
-    let Ok(text) = std::fs::read_to_string(summary) else { return Vec::new() };
+    let Ok(Some(text)) = super::regular::read_regular(summary) else { return Vec::new() };
     let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
     let Some(steps) = json["steps"].as_array() else { return Vec::new() };
     let converged: Vec<&serde_json::Value> = steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).collect();

@@ -81,6 +81,7 @@ pub fn solve_coarse(coarse: CoarseSetup, targets: &[f64]) -> (CoarsePath, Coarse
     model.apply_prescribed(&mut u, 0.0);
     path.record(0.0, &u);
     let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
+    newton.interrupt = super::interrupt::install();
     // counted per converged step: a failed solve returns no summary
     let (mut iterations, mut cutbacks) = (0, 0);
     let result = newton.solve_path(&mut model, &mut u, 0.0, targets, &mut |rep, u, _| {

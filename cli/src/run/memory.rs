@@ -29,9 +29,42 @@ pub fn estimate_bytes(nodes: u64, dofs_per_node: u64) -> f64 {
     BASE_BYTES + BYTES_PER_UNKNOWN_LOG * unknowns * unknowns.max(2.0).log2()
 }
 
-/// The memory this process may use, in bytes: MemAvailable of /proc/meminfo, else MemTotal, else
-/// None (unknown: no check).
+/// Address space a run takes beyond its data: the program, the threads' stacks and the
+/// allocator's per-thread heaps, which are reserved whether used or not. Measured (VmPeak against
+/// VmHWM, `stamp run`, 2026-11-25, 2 threads): 210 MiB for a 14 MiB run, 300 and 370 MiB for the
+/// sphere-displacement plate at n = 100 and 200; below that `ulimit -v` aborts even small runs.
+pub const ADDRESS_SPACE_OVERHEAD: f64 = 512.0 * 1024.0 * 1024.0;
+
+/// Bytes of memory per facet of an STL die, besides the file's own bytes (read whole): the facet
+/// soup, the welded vertices and their normals, the R-tree. Measured: a binary STL of 1 598 000
+/// facets (80 MB) peaks at 610 MB in `stamp check` (2026-11-25), 330 bytes a facet beyond the file.
+pub const BYTES_PER_STL_FACET: f64 = 360.0;
+/// The fewest bytes an ASCII STL spends on a facet (`facet normal`, `outer loop`, three
+/// `vertex` lines, `endloop`, `endfacet`, with the shortest numbers).
+const MIN_ASCII_FACET_BYTES: f64 = 90.0;
+
+/// The memory this process may use, in bytes, and what limits it: the smaller of MemAvailable of
+/// /proc/meminfo (else MemTotal) and the address-space limit (`ulimit -v`, RLIMIT_AS) less
+/// [`ADDRESS_SPACE_OVERHEAD`]; None when neither is known (no check).
 pub fn available_bytes() -> Option<f64> {
+    limit().map(|(bytes, _)| bytes)
+}
+
+/// [`available_bytes`] with the words for what limits it.
+fn limit() -> Option<(f64, String)> {
+    let memory = meminfo().map(|b| (b, "available".to_string()));
+    let address = address_space_limit().map(|l| {
+        let usable = (l - ADDRESS_SPACE_OVERHEAD).max(0.0);
+        (usable, format!("usable under ulimit -v ({:.2} GiB less {:.2} GiB for stacks and heaps)", l / GIB, ADDRESS_SPACE_OVERHEAD / GIB))
+    });
+    match (memory, address) {
+        (Some(m), Some(a)) => Some(if a.0 < m.0 { a } else { m }),
+        (m, a) => m.or(a),
+    }
+}
+
+/// MemAvailable of /proc/meminfo, else MemTotal.
+fn meminfo() -> Option<f64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
     let field = |name: &str| -> Option<f64> {
         let line = text.lines().find(|l| l.starts_with(name))?;
@@ -41,19 +74,59 @@ pub fn available_bytes() -> Option<f64> {
     field("MemAvailable:").or_else(|| field("MemTotal:"))
 }
 
+/// The soft address-space limit of this process (RLIMIT_AS) in bytes; None when unlimited.
+fn address_space_limit() -> Option<f64> {
+    let mut r = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+    // SAFETY: getrlimit writes the struct it is given
+    let rc = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut r) };
+    (rc == 0 && r.rlim_cur != libc::RLIM_INFINITY).then_some(r.rlim_cur as f64)
+}
+
+/// Estimated memory of an STL die read from `path`: the file's bytes and [`BYTES_PER_STL_FACET`]
+/// for each facet (a binary file's header count when its size matches, else as many facets as
+/// the shortest ASCII text could hold); 0 for a file that cannot be looked at (reading it will say).
+pub fn stl_bytes(path: &std::path::Path) -> f64 {
+    use std::io::Read;
+    let Ok(meta) = std::fs::metadata(path) else { return 0.0 };
+    let size = meta.len() as f64;
+    let mut head = [0u8; 84];
+    let binary_count = std::fs::File::open(path)
+        .ok()
+        .filter(|_| meta.is_file())
+        .and_then(|mut f| f.read_exact(&mut head).ok())
+        .map(|()| u32::from_le_bytes([head[80], head[81], head[82], head[83]]) as f64)
+        .filter(|&n| 84.0 + 50.0 * n == size);
+    let facets = binary_count.unwrap_or(size / MIN_ASCII_FACET_BYTES);
+    size + BYTES_PER_STL_FACET * facets
+}
+
 /// Ok if a model of `nodes` nodes with `dofs_per_node` unknowns each fits in the available
 /// memory; else what it needs and what to do, as a message (the caller names the file and key).
 pub fn check_model_fits(nodes: u64, dofs_per_node: u64) -> Result<(), String> {
-    check_against(nodes, dofs_per_node, available_bytes())
+    check_with(nodes, dofs_per_node, &[], limit())
+}
+
+/// [`check_model_fits`] for the problem `p`, whose STL dies take their share too.
+pub fn check_problem_fits(p: &super::problem::Problem, nodes: u64, dofs_per_node: u64) -> Result<(), String> {
+    let dies: Vec<(String, f64)> = p.spec.punch.iter().filter_map(|s| s.get_ref().file.as_ref()).map(|f| (stamp::quote(f.get_ref()), stl_bytes(&p.dir().join(f.get_ref())))).collect();
+    check_with(nodes, dofs_per_node, &dies, limit())
 }
 
 /// [`check_model_fits`] against a given amount of memory (None: unknown, accepted).
 pub fn check_against(nodes: u64, dofs_per_node: u64, available: Option<f64>) -> Result<(), String> {
-    let need = estimate_bytes(nodes, dofs_per_node);
-    match available {
-        Some(avail) if need > avail => Err(format!(
-            "the model has {nodes} nodes ({} unknowns) and needs about {:.1} GiB of memory (mesh, sparse matrix, LDL^T factor), \
-             but only {:.1} GiB is available: use a coarser mesh, or a machine with more memory",
+    check_with(nodes, dofs_per_node, &[], available.map(|a| (a, "available".to_string())))
+}
+
+/// The check: the model's estimate and the STL dies' (file, bytes) against the memory `limit`
+/// (bytes, and the words for where it comes from).
+fn check_with(nodes: u64, dofs_per_node: u64, dies: &[(String, f64)], limit: Option<(f64, String)>) -> Result<(), String> {
+    let need = estimate_bytes(nodes, dofs_per_node) + dies.iter().map(|d| d.1).sum::<f64>();
+    let die_words: String = dies.iter().map(|(f, b)| format!(", STL die {f} {:.2} GiB", b / GIB)).collect();
+    let coarser = if dies.is_empty() { "a coarser mesh" } else { "a coarser mesh or STL die" };
+    match limit {
+        Some((avail, what)) if need > avail => Err(format!(
+            "the model has {nodes} nodes ({} unknowns) and needs about {:.2} GiB of memory (mesh, sparse matrix, LDL^T factor{die_words}), \
+             but only {:.2} GiB is {what}: use {coarser}, or a machine with more memory",
             nodes.saturating_mul(dofs_per_node),
             need / GIB,
             avail / GIB
@@ -85,9 +158,27 @@ mod tests {
     }
 
     #[test]
+    fn an_stl_die_counts_by_its_facets() {
+        let dir = std::env::temp_dir().join(format!("stamp-memory-stl-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // binary: 84 + 50 n bytes with n in the header
+        let mut bytes = vec![0u8; 84 + 50 * 1000];
+        bytes[80..84].copy_from_slice(&1000u32.to_le_bytes());
+        std::fs::write(dir.join("b.stl"), &bytes).unwrap();
+        assert_eq!(stl_bytes(&dir.join("b.stl")), bytes.len() as f64 + 1000.0 * BYTES_PER_STL_FACET);
+        // ASCII: as many facets as the shortest text could hold
+        std::fs::write(dir.join("a.stl"), "solid x\n".repeat(900)).unwrap();
+        assert_eq!(stl_bytes(&dir.join("a.stl")), 7200.0 + 80.0 * BYTES_PER_STL_FACET);
+        assert_eq!(stl_bytes(&dir.join("none.stl")), 0.0);
+        let e = check_with(441, DOFS_PER_NODE, &[("die.stl".into(), 2.0 * GIB)], Some((1.0 * GIB, "available".into()))).unwrap_err();
+        assert!(e.contains("STL die die.stl 2.00 GiB") && e.contains("coarser mesh or STL die"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn a_model_too_large_is_refused_with_the_estimate() {
         let e = check_against(25_010_001, DOFS_PER_NODE, Some(8.0 * GIB)).unwrap_err();
-        assert!(e.contains("25010001 nodes") && e.contains("GiB") && e.contains("8.0 GiB is available") && e.contains("coarser mesh"), "{e}");
+        assert!(e.contains("25010001 nodes") && e.contains("GiB") && e.contains("8.00 GiB is available") && e.contains("coarser mesh"), "{e}");
         assert!(check_against(441, DOFS_PER_NODE, Some(8.0 * GIB)).is_ok());
         assert!(check_against(u64::MAX, DOFS_PER_NODE, None).is_ok());
         assert!(check_against(u64::MAX, DOFS_PER_NODE, Some(1e12)).is_err());

@@ -8,21 +8,27 @@
 //! * [`check`]: what is wrong with a built problem, said before the solve (`stamp check`), with
 //!   [`rigid_modes`] (rigid motions held by nothing), [`travel_modes`] (force-driven punches'
 //!   travels held by nothing) and [`punch_start`] (gaps at the start);
-//! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those);
+//! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those),
+//!   locked by [`folder_lock`] against a second run; [`regular`] refuses FIFOs and the like there;
 //! * [`solve`]: Newton-Raphson along the targets with a progress bar, writing every step;
 //! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step;
 //! * [`refine`]: `stamp run --refine`, the run on refined meshes, with [`richardson`] and
 //!   [`refine_report`] (the estimates in the table, history.csv and summary.json);
 //! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in [`crate::paper`]).
 
+pub mod abort_note;
 pub mod build;
+pub mod cell_shape;
 pub mod coarse;
+pub mod folder_lock;
 pub mod check;
 pub mod history;
+pub mod interrupt;
 pub mod memory;
 pub mod mesh;
 pub mod out_dir;
 pub mod output;
+pub mod own_inputs;
 pub mod plate_model;
 pub mod plot;
 pub mod probe;
@@ -31,6 +37,8 @@ pub mod problem;
 pub mod punch_start;
 pub mod refine;
 pub mod refine_report;
+pub mod regular;
+pub mod reserve;
 pub mod richardson;
 pub mod rigid_modes;
 pub mod solve;
@@ -69,11 +77,11 @@ pub fn check_command(problem: &Path) -> stamp::Result<()> {
     let p = Problem::read(problem)?;
     let setup = build::build(&p)?;
     let report = check::check(&p, &setup)?;
-    println!("{}", report.summary);
+    crate::outln!("{}", report.summary);
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
-    println!("check: no errors{}", match report.warnings.len() {
+    crate::outln!("check: no errors{}", match report.warnings.len() {
         0 => String::new(),
         1 => ", 1 warning".into(),
         n => format!(", {n} warnings"),
@@ -94,7 +102,7 @@ pub fn run_command(problem: &Path, out: Option<&Path>, quiet: bool, refine: Opti
             Some(n) => format!("; the refined meshes' in {} ... {}", outcome.out_dir.join(refine::level_folder(1)).display(), refine::level_folder(n)),
             None => String::new(),
         };
-        println!(
+        crate::outln!(
             "stamp run: {} converged steps; results in {} (summary.json, .pvd/.vtu, CSV){refined}",
             outcome.converged_steps,
             outcome.out_dir.display()

@@ -14,7 +14,13 @@
 //! pressure_*, probe_*, force_travel_* .csv/.png/.svg, history.csv). A folder written before manifests existed (summary.json without a
 //! manifest) loses what that summary.json names: summary.json, the steps' .vtu and .csv files,
 //! the .pvd and the punches' pressure plots.
+//!
+//! A claim first locks the folder ([`FolderLock`]: a second run is refused while the first lives),
+//! refuses a manifest or summary.json that is not a regular file ([`super::regular`]), and
+//! removes the temporary files (`.NAME.tmp-PID-N`) a killed run left in the middle of a write.
 
+use super::folder_lock::{FolderLock, LOCK_FILE};
+use super::regular::{read_regular, refuse_non_regular};
 use serde::{Deserialize, Serialize};
 use stamp::io::write_string_atomically;
 use stamp::{Result, StampError};
@@ -45,6 +51,8 @@ pub struct RunFolder {
     before: BTreeMap<OsString, Option<SystemTime>>,
     /// Files the claim removed (the previous run's).
     pub removed: Vec<String>,
+    /// No other run writes into the folder while this one holds it.
+    _lock: FolderLock,
 }
 
 /// Regular files of `dir` (not the manifest) with their modification times.
@@ -53,7 +61,7 @@ fn listing(dir: &Path) -> Result<BTreeMap<OsString, Option<SystemTime>>> {
     for entry in std::fs::read_dir(dir).map_err(|e| StampError::io(dir, e))? {
         let entry = entry.map_err(|e| StampError::io(dir, e))?;
         let Ok(meta) = entry.metadata() else { continue };
-        if meta.is_file() && entry.file_name() != MANIFEST {
+        if meta.is_file() && entry.file_name() != MANIFEST && entry.file_name() != LOCK_FILE && entry.file_name() != super::reserve::RESERVE {
             out.insert(entry.file_name(), meta.modified().ok());
         }
     }
@@ -62,11 +70,11 @@ fn listing(dir: &Path) -> Result<BTreeMap<OsString, Option<SystemTime>>> {
 
 /// A bare file name (no path separators, not "." or ".."): the only names the manifest may remove.
 fn plain_name(name: &str) -> bool {
-    !name.is_empty() && name != "." && name != ".." && !name.contains('/') && !name.contains('\\') && name != MANIFEST
+    !name.is_empty() && name != "." && name != ".." && !name.contains('/') && !name.contains('\\') && name != MANIFEST && name != LOCK_FILE
 }
 
 /// Named like one of stamp's outputs.
-fn looks_like_output(name: &str) -> bool {
+pub fn looks_like_output(name: &str) -> bool {
     name == "summary.json"
         || name.ends_with(".vtu")
         || name.ends_with(".pvd")
@@ -76,11 +84,11 @@ fn looks_like_output(name: &str) -> bool {
 }
 
 /// The files a summary.json written without a manifest names.
-fn legacy_outputs(dir: &Path) -> Vec<String> {
-    let Ok(text) = std::fs::read_to_string(dir.join("summary.json")) else { return Vec::new() };
-    let Ok(s) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
+fn legacy_outputs(dir: &Path) -> Result<Vec<String>> {
+    let Some(text) = read_regular(&dir.join("summary.json"))? else { return Ok(Vec::new()) };
+    let Ok(s) = serde_json::from_str::<serde_json::Value>(&text) else { return Ok(Vec::new()) };
     if !(s["steps"].is_array() && s["problem"].is_string()) {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let mut names = vec!["summary.json".to_string()];
     for step in s["steps"].as_array().unwrap() {
@@ -102,19 +110,26 @@ fn legacy_outputs(dir: &Path) -> Vec<String> {
             names.push(format!("pressure_{n}.svg"));
         }
     }
-    names
+    Ok(names)
 }
 
 impl RunFolder {
-    /// Create `dir` if needed, remove the previous run's files and mark the folder as in use.
+    /// Create `dir` if needed, lock it (refused while another run holds it, see
+    /// [`FolderLock`]), remove the previous run's files and mark the folder as in use.
     pub fn claim(dir: &Path) -> Result<RunFolder> {
         std::fs::create_dir_all(dir).map_err(|e| StampError::io(dir, e))?;
+        let lock = FolderLock::acquire(dir)?;
+        // the files of its own a run reads back or replaces: never a FIFO or a device
+        for name in [MANIFEST, "summary.json"] {
+            refuse_non_regular(&dir.join(name))?;
+        }
         let mut removed = remove_previous_outputs(dir, true)?;
+        removed.extend(remove_temporaries(dir)?);
         removed.extend(remove_refined_runs(dir)?);
         let before = listing(dir)?;
         let manifest = Manifest { status: "running".into(), written: Vec::new(), before: before.keys().filter_map(|k| k.to_str().map(String::from)).collect() };
         write_manifest(dir, &manifest)?;
-        Ok(RunFolder { dir: dir.to_path_buf(), before, removed })
+        Ok(RunFolder { dir: dir.to_path_buf(), before, removed, _lock: lock })
     }
 
     /// The files written since the claim: new ones, and old ones rewritten.
@@ -140,8 +155,8 @@ impl RunFolder {
 /// Removes the files the previous run wrote in `dir` (see the module notes; `legacy`: also a
 /// folder written before manifests existed) and returns their names.
 fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {
-    let previous: Vec<String> = match std::fs::read_to_string(dir.join(MANIFEST)) {
-        Ok(text) => match serde_json::from_str::<Manifest>(&text) {
+    let previous: Vec<String> = match read_regular(&dir.join(MANIFEST))? {
+        Some(text) => match serde_json::from_str::<Manifest>(&text) {
             Ok(m) if m.status == "complete" => m.written,
             Ok(m) => {
                 // killed mid-run: stamp-named files that were not there before it
@@ -150,8 +165,8 @@ fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {
             }
             Err(_) => Vec::new(),
         },
-        Err(_) if legacy => legacy_outputs(dir),
-        Err(_) => Vec::new(),
+        None if legacy => legacy_outputs(dir)?,
+        None => Vec::new(),
     };
     let mut removed = Vec::new();
     for name in previous.iter().filter(|n| plain_name(n)) {
@@ -159,6 +174,32 @@ fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {
         if std::fs::symlink_metadata(&path).map(|m| m.is_file()).unwrap_or(false) {
             std::fs::remove_file(&path).map_err(|e| StampError::io(&path, e))?;
             removed.push(name.clone());
+        }
+    }
+    Ok(removed)
+}
+
+/// Whether `name` is that of a temporary file of [`stamp::io::write_atomically`]:
+/// `.<name>.tmp-<pid>-<n>`.
+fn is_temporary(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.') else { return false };
+    let Some((_, tail)) = rest.rsplit_once(".tmp-") else { return false };
+    let mut parts = tail.split('-');
+    let digits = |p: Option<&str>| p.is_some_and(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()));
+    digits(parts.next()) && digits(parts.next()) && parts.next().is_none()
+}
+
+/// Removes the temporary files a killed run left in `dir` (regular files named like those of
+/// [`stamp::io::write_atomically`]): with the folder locked, no other run is writing them.
+fn remove_temporaries(dir: &Path) -> Result<Vec<String>> {
+    let mut removed = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(|e| StampError::io(dir, e))? {
+        let entry = entry.map_err(|e| StampError::io(dir, e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let regular = entry.file_type().map(|t| t.is_file()).unwrap_or(false);
+        if regular && is_temporary(&name) {
+            std::fs::remove_file(entry.path()).map_err(|e| StampError::io(entry.path(), e))?;
+            removed.push(name);
         }
     }
     Ok(removed)
@@ -180,8 +221,12 @@ fn remove_refined_runs(dir: &Path) -> Result<Vec<String>> {
         if !is_refined_name || !is_dir || !sub.join(MANIFEST).is_file() {
             continue;
         }
-        removed.extend(remove_previous_outputs(&sub, false)?.into_iter().map(|f| format!("{name}/{f}")));
+        // refused while a run writes into it
+        let lock = FolderLock::acquire(&sub)?;
+        removed.extend(remove_previous_outputs(&sub, false)?.into_iter().chain(remove_temporaries(&sub)?).map(|f| format!("{name}/{f}")));
         std::fs::remove_file(sub.join(MANIFEST)).map_err(|e| StampError::io(&sub.join(MANIFEST), e))?;
+        let _ = std::fs::remove_file(sub.join(LOCK_FILE));
+        drop(lock);
         // only if empty: files the user put there stay, and so does the folder
         let _ = std::fs::remove_dir(&sub);
     }
@@ -228,7 +273,7 @@ mod tests {
                 std::fs::write(d.join(format!("a_{k:04}.vtu")), "x").unwrap();
             }
         }
-        assert_eq!(names(&d), [".stamp-run", "a_0001.vtu", "a_0002.vtu", "a_0003.vtu", "notes.txt"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "a_0001.vtu", "a_0002.vtu", "a_0003.vtu", "notes.txt"]);
         // a file the user adds afterwards, even named like an output, survives the next run
         std::fs::write(d.join("b_0009.vtu"), "mine").unwrap();
         {
@@ -236,7 +281,7 @@ mod tests {
             assert_eq!(f.removed, ["a_0001.vtu", "a_0002.vtu", "a_0003.vtu"]);
             std::fs::write(d.join("a_0001.vtu"), "y").unwrap();
         }
-        assert_eq!(names(&d), [".stamp-run", "a_0001.vtu", "b_0009.vtu", "notes.txt"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "a_0001.vtu", "b_0009.vtu", "notes.txt"]);
     }
 
     #[test]
@@ -276,7 +321,17 @@ mod tests {
         let f = RunFolder::claim(&d).unwrap();
         assert_eq!(f.removed, ["a_0001.vtu", "summary.json"]);
         drop(f);
-        assert_eq!(names(&d), [".stamp-run", "later.txt", "notes.txt"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "later.txt", "notes.txt"]);
+    }
+
+    #[test]
+    fn temporary_files_are_told_from_the_users() {
+        for name in [".summary.json.tmp-123-0", ".p_0001.vtu.tmp-4-17", ".a.tmp-b.tmp-1-2"] {
+            assert!(is_temporary(name), "{name}");
+        }
+        for name in ["summary.json.tmp-123-0", ".x.tmp-1", ".x.tmp-1-2-3", ".x.tmp-a-2", ".x.tmp--2", "notes.txt"] {
+            assert!(!is_temporary(name), "{name}");
+        }
     }
 
     #[test]
@@ -288,6 +343,6 @@ mod tests {
         }
         std::fs::write(d.join("summary.json"), summary).unwrap();
         drop(RunFolder::claim(&d).unwrap());
-        assert_eq!(names(&d), [".stamp-run", "notes.txt", "p_0002.vtu"]);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "notes.txt", "p_0002.vtu"]);
     }
 }

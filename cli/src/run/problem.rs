@@ -69,6 +69,13 @@ pub mod limits {
     /// Most equal steps (`solver.steps`) and most load increments a path may need at
     /// `max_increment` (path length / max_increment).
     pub const MAX_STEPS: u64 = 100_000;
+    /// Largest `solver.max_steps`.
+    pub const MAX_STEP_BUDGET: u64 = 10_000_000;
+    /// The default `solver.max_steps`: at least this many steps, and [`STEP_BUDGET_FACTOR`] times
+    /// the increments the path needs at max_increment (or its targets) if that is more.
+    pub const DEFAULT_MAX_STEPS: usize = 1000;
+    /// See [`DEFAULT_MAX_STEPS`].
+    pub const STEP_BUDGET_FACTOR: usize = 10;
     /// Largest load factor of a target.
     pub const MAX_LOAD_FACTOR: f64 = 1e6;
     /// Smallest load increment (max_increment, min_increment, initial_increment).
@@ -143,6 +150,7 @@ checked_count!(IterationCount, 1, limits::MAX_ITERATIONS);
 checked_count!(CycleCount, 0, limits::MAX_ITERATIONS);
 checked_count!(LineSearchCount, 0, limits::MAX_LINE_SEARCH_STEPS);
 checked_count!(CutbackCount, 0, limits::MAX_CUTBACKS);
+checked_count!(MaxStepCount, 1, limits::MAX_STEP_BUDGET);
 
 /// A 3-vector of finite numbers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -694,6 +702,9 @@ pub struct SolverSpec {
     pub max_iterations: Option<IterationCount>,
     #[serde(default)]
     pub max_cutbacks: Option<CutbackCount>,
+    /// Most converged load steps of the path (see [`Problem::max_steps`]).
+    #[serde(default)]
+    pub max_steps: Option<Spanned<MaxStepCount>>,
     #[serde(default)]
     pub line_search_steps: Option<LineSearchCount>,
     /// Give up a step whose active set swings at every iteration without progress from this
@@ -1181,12 +1192,39 @@ impl Problem {
                 format!("the load path (length {}) needs {} increments of max_increment = {}; at most {} are allowed: raise max_increment or shorten the targets", num(path), num(increments.ceil()), num(max_inc), limits::MAX_STEPS),
             ));
         }
+        if let Some(m) = &sv.max_steps {
+            let least = self.least_steps();
+            if m.get_ref().0 < least {
+                return Err(self.error_at(m.span(), "solver.max_steps", format!("{} is fewer than the {least} steps the path needs at least (its targets, and increments of at most max_increment = {})", m.get_ref().0, num(max_inc))));
+            }
+        }
         let largest = targets.iter().cloned().fold(1.0, f64::max);
         let floor = 1e-12 * largest;
         if min_inc < floor {
             return Err(fail(span_of(&sv.min_increment), "solver.min_increment", format!("{} is below the round-off of load factors up to {}; the smallest allowed is {}", num(min_inc), num(largest), num(floor))));
         }
         Ok(())
+    }
+
+    /// The fewest steps the path can take: one per target, and as many increments of
+    /// max_increment as its length needs.
+    pub fn least_steps(&self) -> usize {
+        let max_inc = self.spec.solver.max_increment.as_ref().map_or(DEFAULT_MAX_INCREMENT, |x| x.get_ref().0);
+        let targets = self.targets();
+        let path: f64 = targets.iter().fold((0.0, 0.0), |(len, last): (f64, f64), &t| (len + (t - last).abs(), t)).0;
+        // bounded by limits::MAX_STEPS (check_increments)
+        let increments = (path / max_inc * (1.0 - 1e-12)).ceil().min(limits::MAX_STEPS as f64) as usize;
+        increments.max(targets.len())
+    }
+
+    /// `[solver] max_steps`: the most converged load steps of the path before it is given up (see
+    /// [`stamp::nonlinear::NewtonSettings::max_steps`]); by default [`limits::DEFAULT_MAX_STEPS`],
+    /// or [`limits::STEP_BUDGET_FACTOR`] times [`least_steps`](Self::least_steps) if that is more.
+    pub fn max_steps(&self) -> usize {
+        match &self.spec.solver.max_steps {
+            Some(m) => m.get_ref().0,
+            None => limits::DEFAULT_MAX_STEPS.max(limits::STEP_BUDGET_FACTOR * self.least_steps()),
+        }
     }
 
     /// The name of punch `i` (its `name`, or "`punch<i>`").

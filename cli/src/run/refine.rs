@@ -72,7 +72,7 @@ pub fn check_levels_fit(sizes: &[(u64, u64)], levels: usize, dofs_per_node: u64,
 /// Rewrite summary.json in `dir` with `edit` applied (atomically).
 fn edit_summary(dir: &Path, edit: impl FnOnce(&mut Value)) -> Result<()> {
     let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| StampError::io(&path, e))?;
+    let text = super::regular::read_regular(&path)?.ok_or_else(|| StampError::io(&path, std::io::ErrorKind::NotFound.into()))?;
     let mut v: Value = serde_json::from_str(&text).map_err(|e| StampError::Problem(format!("{}: cannot read back summary.json: {e}", stamp::show_path(&path))))?;
     edit(&mut v);
     let text = serde_json::to_string_pretty(&v).map_err(|e| StampError::Problem(format!("cannot encode summary.json: {e}")))?;
@@ -102,6 +102,9 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     let sizes = stamp::mesh_refine::refined_sizes(&setup.mesh.mesh, levels);
     check_levels_fit(&sizes, levels, super::memory::dofs_per_node(p.spec.plate.get_ref().surfaces), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
+    // the folder is this run's until the last mesh is solved (the runs below claim it again)
+    std::fs::create_dir_all(&out_dir).map_err(|e| StampError::io(&out_dir, e))?;
+    let _lock = super::folder_lock::FolderLock::acquire(&out_dir)?;
     let units = Units::new(p.spec.units.as_ref());
     let force_driven: Vec<bool> = p.spec.punch.iter().map(|s| s.get_ref().force.is_some()).collect();
     let mut meshes = vec![mesh_entry(0, &setup.mesh)];
@@ -157,10 +160,11 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
             Err(e) => {
                 let e = StampError::Problem(format!("{}: the mesh refined {} (results in {}): {e}", stamp::show_path(&p.path), times(level), stamp::show_path(&dir)));
                 let message = e.to_string();
+                let status = if super::interrupt::received().is_some() { "interrupted" } else { "failed" };
                 edit_summary(&out_dir, |v| {
-                    v["status"] = json!("failed");
+                    v["status"] = json!(status);
                     v["error"] = json!(message);
-                    v["refinement"] = refinement(format!("failed: the mesh refined {}", times(level)), &meshes);
+                    v["refinement"] = refinement(format!("{status}: the mesh refined {}", times(level)), &meshes);
                 })?;
                 return Err(e);
             }
@@ -193,9 +197,9 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         v["refinement"]["seconds"] = json!(seconds);
     })?;
     if !quiet {
-        print!("{}", super::table::render(&coarse.history, &units));
-        print!("{}", rep.tables(&coarse.history));
-        println!("{}", explanation(levels));
+        crate::out!("{}", super::table::render(&coarse.history, &units));
+        crate::out!("{}", rep.tables(&coarse.history));
+        crate::outln!("{}", explanation(levels));
     }
     Ok(RunOutcome { files, ..coarse })
 }

@@ -135,11 +135,11 @@ pub fn rfc3339_utc(time: std::time::SystemTime) -> String {
     format!("{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem % 3600 / 60, rem % 60)
 }
 
-/// Write summary.json; an error says that it was summary.json that could not be written, and
-/// what had gone wrong before (`earlier`), if anything.
-fn write_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>) -> Result<()> {
+/// Write summary.json and return its size; an error says that it was summary.json that could not
+/// be written, and what had gone wrong before (`earlier`), if anything.
+fn write_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>) -> Result<usize> {
     let text = serde_json::to_string_pretty(summary).map_err(json_err)?;
-    write_string_atomically(path, &text).map_err(|e| {
+    write_string_atomically(path, &text).map(|()| text.len()).map_err(|e| {
         let kind = match &e {
             StampError::Io { source, .. } => source.kind(),
             _ => std::io::ErrorKind::Other,
@@ -154,6 +154,43 @@ fn write_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>) -
         };
         StampError::Io { path: path.display().to_string(), source: std::io::Error::new(kind, message) }
     })
+}
+
+/// Write the final summary.json: as usual; if that fails (a full disk), again once the reserve
+/// ([`super::reserve`]) gave its space back; if that fails too, the summary.json of the run so far
+/// (which says "running") is removed, so that none says what is no longer true, and a compact one
+/// is tried in its place. The error, if any, says what became of summary.json.
+fn write_final_summary(path: &Path, summary: &Summary, earlier: Option<&StampError>, reserve: &mut super::reserve::Reserve) -> Result<()> {
+    let first = match write_summary(path, summary, earlier) {
+        Ok(_) => return Ok(()),
+        Err(e) => e,
+    };
+    if reserve.release() && write_summary(path, summary, earlier).is_ok() {
+        return Ok(());
+    }
+    let removed = std::fs::remove_file(path).is_ok();
+    if let Ok(text) = serde_json::to_string(summary) {
+        if write_string_atomically(path, &text).is_ok() {
+            return Ok(());
+        }
+    }
+    let tail = if removed { "; the summary.json of the run so far (status \"running\") was removed" } else { "" };
+    Err(match first {
+        StampError::Io { path, source } => StampError::Io { path, source: std::io::Error::new(source.kind(), format!("{source}{tail}")) },
+        e => StampError::Problem(format!("{e}{tail}")),
+    })
+}
+
+/// summary.json as it would be if the process aborted now: "failed", with the steps listed so far.
+fn aborted(summary: &Summary) -> String {
+    let mut v = serde_json::to_value(summary).unwrap_or_default();
+    let steps = summary.steps.len();
+    v["status"] = "failed".into();
+    v["error"] = format!(
+        "the process aborted (SIGABRT) after the {steps} steps listed here were written: most likely an allocation failed (out of memory), see stderr"
+    )
+    .into();
+    serde_json::to_string_pretty(&v).unwrap_or_default()
 }
 
 /// The progress bar: the load path along the bar, Newton iteration and residual in the message.
@@ -243,10 +280,20 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let quiet = opts.quiet;
     let start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
+    super::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
+    // from here on Ctrl-C and SIGTERM abandon the step in progress (see interrupt.rs): a signal
+    // that comes before the solve ends it at its first iteration
+    let interrupt = super::interrupt::install();
     // removes the previous run's files; records this run's when dropped (see out_dir.rs)
     let _folder = super::out_dir::RunFolder::claim(out_dir)?;
     let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
     let targets = opts.targets.clone().unwrap_or(targets);
+    // the step budget of the path (a refined run passes through the targets it is given)
+    let mut settings = settings;
+    settings.max_steps = match &opts.targets {
+        Some(t) => p.max_steps().max(super::problem::limits::STEP_BUDGET_FACTOR.saturating_mul(t.len())),
+        None => p.max_steps(),
+    };
     let out = &p.spec.output;
     let stem = p.path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "step".into());
     let path_end = targets.iter().fold((0.0, 0.0), |(len, last), &t| (len + (t - last).abs(), t)).0.max(f64::MIN_POSITIVE);
@@ -337,8 +384,13 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut write_error: Option<StampError> = None;
     let mut total_iterations = 0;
     let mut total_failed = 0;
+    // room for the final summary.json, whatever fills the disk meanwhile
+    let mut reserve = super::reserve::Reserve::create(out_dir)?;
     // a reader sees "running" (with our pid) from the start
-    write_summary(&summary_path, &summary, None)?;
+    reserve.cover(write_summary(&summary_path, &summary, None)?);
+    // what summary.json says if the process aborts from here on (see abort_note.rs)
+    let abort_note = super::abort_note::AbortNote::new();
+    abort_note.prepare(&summary_path, aborted(&summary));
 
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
@@ -350,18 +402,22 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         if !quiet {
             eprintln!("coarse predictor: solving on the coarse mesh ({} nodes) first", coarse.setup.mesh.mesh.num_nodes());
         }
+        let mut coarse = coarse;
+        coarse.setup.settings.max_steps = newton.settings.max_steps;
         let (path, report) = super::coarse::solve_coarse(*coarse, &targets);
         if !quiet || report.error.is_some() {
             eprintln!("{}", report.line());
         }
         super::coarse::predict_from(&mut newton, path);
         summary.coarse_predictor = Some(report);
-        write_summary(&summary_path, &summary, None)?;
+        reserve.cover(write_summary(&summary_path, &summary, None)?);
+        abort_note.prepare(&summary_path, aborted(&summary));
     }
     newton.on_iteration = progress.callback();
     // a failed output write ends the run after its step (what follows could not be written)
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     newton.stop = Some(stop.clone());
+    newton.interrupt = interrupt;
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let mut surface_error: Option<StampError> = None;
@@ -453,7 +509,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             summary.failed_iterations = total_failed;
             summary.seconds = start.elapsed().as_secs_f64();
             // a failed write here is retried at the end (with the failure)
-            write_summary(&summary_path, &summary, None)
+            write_summary(&summary_path, &summary, None).map(|bytes| {
+                reserve.cover(bytes);
+                abort_note.prepare(&summary_path, aborted(&summary));
+            })
         });
         match step_result {
             Ok(()) => {
@@ -482,7 +541,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     // after a write failure the solve stopped on request: that is no failure of its own
     let surface_error = surface_error.or_else(|| surface_failure(p, &model.contacts));
     let solve_failure = if write_error.is_some() { None } else { surface_error.or(result.err()) };
-    if let Some(e) = &solve_failure {
+    // an interrupted step is no failed step, nor is a path stopped after a converged step for its
+    // step budget (the error says why): summary.json lists the written steps only
+    let no_failed_step = matches!(solve_failure, Some(StampError::Interrupted { .. } | StampError::StepLimit { .. }));
+    if let Some(e) = solve_failure.as_ref().filter(|_| !no_failed_step) {
         let lf = match e {
             StampError::NoConvergence { load_factor, .. } => Some(*load_factor),
             _ => None,
@@ -515,18 +577,25 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         failure = failure.or(Some(e));
     }
     if !quiet && (!opts.no_table || failure.is_some()) {
-        print!("{}", super::table::render(&history, &units));
+        crate::out!("{}", super::table::render(&history, &units));
     }
     summary.seconds = start.elapsed().as_secs_f64();
     match &failure {
         None if opts.caller_finishes => {}
         None => summary.status = "converged".into(),
+        Some(e @ StampError::Interrupted { .. }) => {
+            summary.status = "interrupted".into();
+            let by = super::interrupt::received().map(|s| format!("interrupted by {}", super::interrupt::name(s))).unwrap_or_else(|| "interrupted".into());
+            summary.error = Some(e.to_string().replacen("interrupted", &by, 1));
+        }
         Some(e) => {
             summary.status = "failed".into();
             summary.error = Some(e.to_string());
         }
     }
-    write_summary(&summary_path, &summary, failure.as_ref())?;
+    abort_note.withdraw();
+    write_final_summary(&summary_path, &summary, failure.as_ref(), &mut reserve)?;
+    drop(reserve);
     files.push(summary_path.clone());
     let converged_steps = summary.steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).count();
     match failure {

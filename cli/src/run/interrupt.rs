@@ -1,0 +1,61 @@
+//! Ctrl-C (SIGINT) and SIGTERM end a run cleanly: the handlers ([`install`], from the start of a
+//! solve on) only set a flag, which Newton checks before every iteration
+//! ([`stamp::nonlinear::NewtonRaphson::interrupt`]); the step in progress is abandoned, the
+//! converged steps stay written, summary.json says "interrupted" and the program exits with
+//! 128 + the signal's number (130, 143), as a shell reports a process ended by it. A second
+//! signal while the first is being handled ends the program at once.
+
+use signal_hook::consts::{SIGINT, SIGTERM};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
+
+struct Flags {
+    /// Set by either signal.
+    any: Arc<AtomicBool>,
+    /// The number of the signal received last.
+    which: Arc<AtomicUsize>,
+}
+
+static FLAGS: OnceLock<Option<Flags>> = OnceLock::new();
+
+/// Install the handlers (once per process; later calls do nothing) and return the flag they set
+/// (None if they could not be installed: the signals then end the program as by default).
+pub fn install() -> Option<Arc<AtomicBool>> {
+    let flags = FLAGS.get_or_init(|| {
+        let flags = Flags { any: Arc::new(AtomicBool::new(false)), which: Arc::new(AtomicUsize::new(0)) };
+        for sig in [SIGINT, SIGTERM] {
+            // the second signal, with the flag already set, exits at once (status 128 + sig)
+            signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, flags.any.clone()).ok()?;
+            signal_hook::flag::register_usize(sig, flags.which.clone(), sig as usize).ok()?;
+            signal_hook::flag::register(sig, flags.any.clone()).ok()?;
+        }
+        Some(flags)
+    });
+    flags.as_ref().map(|f| f.any.clone())
+}
+
+/// The signal received, if any (SIGINT or SIGTERM).
+pub fn received() -> Option<i32> {
+    let flags = FLAGS.get()?.as_ref()?;
+    if !flags.any.load(Ordering::Relaxed) {
+        return None;
+    }
+    match flags.which.load(Ordering::Relaxed) {
+        0 => None,
+        s => Some(s as i32),
+    }
+}
+
+/// The name of a signal stamp handles.
+pub fn name(signal: i32) -> &'static str {
+    match signal {
+        SIGINT => "SIGINT (Ctrl-C)",
+        SIGTERM => "SIGTERM",
+        _ => "a signal",
+    }
+}
+
+/// The exit status of a program ended by `signal`: 128 + its number.
+pub fn exit_status(signal: i32) -> u8 {
+    (128 + signal).clamp(0, 255) as u8
+}
