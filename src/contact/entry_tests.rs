@@ -84,13 +84,14 @@ fn from_an_empty_set_only_the_deepest_penetrations_enter() {
 
 #[test]
 fn a_lone_point_swinging_in_and_out_is_frozen_after_lone_max_flips_changes() {
-    // nothing penetrates, then point 0 alone: in, out, in (three changes with at most one
-    // point active): frozen, its next swing is no change
+    // nothing penetrates, then point 0 alone: in, out (held for the one evaluation after it
+    // entered), out, in (three changes with at most one point active): frozen, its next swing is
+    // no change
     let mut p = pair(0.5);
     assert_eq!(evaluate(&mut p, [0.0; 4]).0, 0);
     let (inside, outside) = ([1.0, 0.0, 0.0, 0.0], [0.0; 4]);
-    for (k, w) in [inside, outside, inside].into_iter().enumerate() {
-        assert_eq!(evaluate(&mut p, w).0, 1, "change {k}");
+    for (k, (w, changes)) in [(inside, 1), (outside, 0), (outside, 1), (inside, 1)].into_iter().enumerate() {
+        assert_eq!(evaluate(&mut p, w).0, changes, "evaluation {k}");
     }
     assert_eq!(LONE_MAX_FLIPS, 3);
     assert!(p.frozen[0] && !p.frozen[1]);
@@ -99,10 +100,15 @@ fn a_lone_point_swinging_in_and_out_is_frozen_after_lone_max_flips_changes() {
     let mut p = pair(0.5);
     let (inside, outside) = ([1.0, 0.0, 1.0, 1.0], [0.0, 0.0, 1.0, 1.0]);
     assert_eq!(evaluate(&mut p, outside).1, vec![false, false, true, true]);
-    for k in 0..9 {
-        assert_eq!(evaluate(&mut p, if k % 2 == 0 { inside } else { outside }).0, 1, "change {k}");
+    assert_eq!(evaluate(&mut p, outside).0, 0, "points 2 and 3 are settled");
+    for k in 0..5 {
+        assert_eq!(evaluate(&mut p, inside).0, 1, "entry {k}");
+        assert_eq!(evaluate(&mut p, outside), (0, vec![true, false, true, true]), "held after entry {k}");
+        if k < 4 {
+            assert_eq!(evaluate(&mut p, outside).0, 1, "release {k}");
+            assert!(!p.frozen[0]);
+        }
     }
-    assert!(!p.frozen[0]);
     assert_eq!(evaluate(&mut p, outside).0, 1);
     assert!(p.frozen[0], "frozen at the tenth change");
 }
@@ -154,10 +160,19 @@ fn right_after_an_augmented_lagrangian_update_no_point_is_released() {
     assert_eq!((changes, active.clone()), (0, vec![true, true, false, false]), "held right after the update");
     let (changes, active) = evaluate(&mut p, lifted);
     assert_eq!((changes, active), (1, vec![true, false, false, false]), "released at the next evaluation");
-    // without an update in between it is released at once
+    // without an update in between it is released at once (once past the evaluation after it
+    // entered, which holds it too)
     let mut q = pair(0.5);
     evaluate(&mut q, [1.0, 1.0, 0.0, 0.0]);
+    assert_eq!(evaluate(&mut q, [1.0, 1.0, 0.0, 0.0]).0, 0);
     assert_eq!(evaluate(&mut q, lifted), (1, vec![true, false, false, false]));
+    // a point that entered at the last evaluation is held once, then released
+    let mut r = pair(0.5);
+    evaluate(&mut r, [1.0, 0.0, 0.0, 0.0]);
+    assert_eq!(evaluate(&mut r, [1.0, 1.0, 0.0, 0.0]), (1, vec![true, true, false, false]), "point 1 enters");
+    assert_eq!(evaluate(&mut r, lifted), (0, vec![true, true, false, false]), "held the evaluation after it entered");
+    assert!(r.state[1].lambda > 0.0, "its force is the exact (here tensile) trial multiplier");
+    assert_eq!(evaluate(&mut r, lifted), (1, vec![true, false, false, false]), "then released");
 }
 
 #[test]

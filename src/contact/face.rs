@@ -148,12 +148,12 @@ impl ContactFace {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Mesh;
+    use crate::mesh::QuadMesh as Mesh;
 
     #[test]
     fn areas_are_the_consistent_nodal_areas_and_patches_are_the_cells_points() {
         // a distorted 3 x 2 mesh: A_i = int N_i dA, the same as Mesh::nodal_areas
-        let mut m = Mesh::rectangle(0.0, 3.0, 0.0, 2.0, 3, 2);
+        let mut m = Mesh::rectangle(0.0, 3.0, 0.0, 2.0, 3, 2).unwrap();
         m.coords[5] = [1.3, 0.8];
         m.coords[6] = [2.1, 1.2];
         let all: Vec<Option<usize>> = (0..m.coords.len()).map(Some).collect();
@@ -171,7 +171,7 @@ mod tests {
 
     #[test]
     fn a_candidate_off_the_face_is_refused() {
-        let m = Mesh::rectangle(0.0, 2.0, 0.0, 1.0, 2, 1);
+        let m = Mesh::rectangle(0.0, 2.0, 0.0, 1.0, 2, 1).unwrap();
         // only the nodes of the first cell are candidates, plus node 2 of the second
         let mut p: Vec<Option<usize>> = vec![None; m.coords.len()];
         for (k, n) in [0usize, 1, 3, 4, 2].into_iter().enumerate() {
