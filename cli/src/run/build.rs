@@ -150,8 +150,8 @@ pub fn build(p: &Problem) -> Result<Setup> {
     // and a rectangle (checked for the paper's plate when read) too if the plate has more unknowns
     let dofs_per_node = super::memory::dofs_per_node(s.plate.get_ref().surfaces);
     match &s.mesh.get_ref().file {
-        Some(file) => super::memory::check_problem_fits(p, mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(file.span(), "mesh.file", m))?,
-        None => super::memory::check_problem_fits(p, mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(s.mesh.span(), "mesh.rectangle", m))?,
+        Some(file) => super::memory::check_problem_fits(&stl_dies(p), mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(file.span(), "mesh.file", m))?,
+        None => super::memory::check_problem_fits(&stl_dies(p), mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(s.mesh.span(), "mesh.rectangle", m))?,
     }
     let mut setup = build_on(p, mesh)?;
     if s.solver.predictor.as_ref().is_some_and(|k| *k.get_ref() == Predictor::Coarse) {
@@ -538,6 +538,11 @@ fn integrated(pair: ContactPair, mesh: &MeshData, group: Option<&str>) -> Result
     }
     let face = ContactFace::new(&mesh.mesh.coords, &cells, &point_of_node, pair.points.len())?;
     pair.with_face(face)
+}
+
+/// The STL dies of the punches: (the name as written, quoted; its path), for the memory check.
+fn stl_dies(p: &Problem) -> Vec<(String, std::path::PathBuf)> {
+    p.spec.punch.iter().filter_map(|s| s.get_ref().file.as_ref()).map(|f| (stamp::quote(f.get_ref()), p.dir().join(f.get_ref()))).collect()
 }
 
 /// The STL die of a punch: `file` relative to the problem file; errors name the problem file, the

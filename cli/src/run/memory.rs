@@ -106,9 +106,9 @@ pub fn check_model_fits(nodes: u64, dofs_per_node: u64) -> Result<(), String> {
     check_with(nodes, dofs_per_node, &[], limit())
 }
 
-/// [`check_model_fits`] for the problem `p`, whose STL dies take their share too.
-pub fn check_problem_fits(p: &super::problem::Problem, nodes: u64, dofs_per_node: u64) -> Result<(), String> {
-    let dies: Vec<(String, f64)> = p.spec.punch.iter().filter_map(|s| s.get_ref().file.as_ref()).map(|f| (stamp::quote(f.get_ref()), stl_bytes(&p.dir().join(f.get_ref())))).collect();
+/// [`check_model_fits`] with the STL dies (name as written, path) taking their share too.
+pub fn check_problem_fits(stl_dies: &[(String, std::path::PathBuf)], nodes: u64, dofs_per_node: u64) -> Result<(), String> {
+    let dies: Vec<(String, f64)> = stl_dies.iter().map(|(name, path)| (name.clone(), stl_bytes(path))).collect();
     check_with(nodes, dofs_per_node, &dies, limit())
 }
 
