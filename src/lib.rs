@@ -10,9 +10,6 @@
 pub mod error;
 pub mod io;
 pub mod mesh;
-pub mod mesh_check;
-pub mod mesh_refine;
-pub mod mesh_transfer;
 pub mod surface;
 
 pub use error::{quote, show_path, short_path, Result, StampError};
@@ -24,4 +21,3 @@ pub mod contact;
 pub mod follower;
 pub mod model;
 pub mod nonlinear;
-pub mod coarse_path;

@@ -314,7 +314,7 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// of the last converged state, load factor of the step, the start to set); true when it set
     /// the start (then used instead of the secant extrapolation, see
     /// [`NonlinearProblem::start_step`]), false to keep the extrapolation. A
-    /// [`crate::coarse_path::CoarsePath`], say. Not asked for the retries of a step after
+    /// [`crate::mesh::coarse_path::CoarsePath`], say. Not asked for the retries of a step after
     /// [`PREDICTED_ATTEMPTS`] failed attempts in a row.
     pub predictor: Option<Box<dyn FnMut(usize, f64, f64, &mut [f64]) -> bool>>,
     /// Newton iterations done so far, failed attempts included.

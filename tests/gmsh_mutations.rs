@@ -5,7 +5,7 @@
 //! mutated input next to the test binary's scratch directory and names it.
 
 use stamp::io::parse_msh_bytes;
-use stamp::mesh_check::check_mesh;
+use stamp::mesh::check::check_mesh;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 

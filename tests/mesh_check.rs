@@ -1,9 +1,9 @@
-//! The whole-mesh checks (stamp::mesh_check) on small meshes with one defect each, the messages
+//! The whole-mesh checks (stamp::mesh::check) on small meshes with one defect each, the messages
 //! the gmsh reader makes of them (gmsh tags), and the cost on a 400 x 400 mesh (ignored test).
 
 use stamp::io::gmsh::parse_msh_bytes;
 use stamp::mesh::QuadMesh;
-use stamp::mesh_check::{check_mesh, Defect};
+use stamp::mesh::check::{check_mesh, Defect};
 use std::path::Path;
 
 fn mesh(coords: Vec<[f64; 2]>, cells: Vec<[usize; 4]>) -> QuadMesh {

@@ -29,7 +29,7 @@
 //! each cell coordinate.
 
 use crate::error::{Result, StampError};
-use crate::mesh::bilinear;
+use crate::mesh::{bilinear, bilinear_jacobian};
 
 /// A quadrature point of the face: the (up to four) contact points of its cell, their shape
 /// functions there and its weight (reference area).
@@ -72,14 +72,7 @@ impl ContactFace {
             let x: Vec<[f64; 2]> = cell.iter().map(|&n| coords[n]).collect();
             for &(s, t) in &[(-g, -g), (g, -g), (g, g), (-g, g)] {
                 let (n, dn) = bilinear(s, t);
-                let mut j = [[0.0; 2]; 2];
-                for a in 0..4 {
-                    for d in 0..2 {
-                        j[d][0] += x[a][d] * dn[a][0];
-                        j[d][1] += x[a][d] * dn[a][1];
-                    }
-                }
-                let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+                let det = bilinear_jacobian(&x, &dn);
                 if !(det > 0.0 && det.is_finite()) {
                     return Err(StampError::Mesh(format!("cell {c} of the contact face is degenerate or inverted (Jacobian {det:e})")));
                 }

@@ -164,7 +164,7 @@ pub struct ContactPair {
     /// No evaluation with a tangent yet in this load step.
     step_start: bool,
     /// This load step started from an outside prediction of its answer (the solution on a
-    /// coarse mesh, [`crate::coarse_path`]): no damped entry in it, every penetrating point
+    /// coarse mesh, [`crate::mesh::coarse_path`]): no damped entry in it, every penetrating point
     /// enters at once. The damping guards against the secant predictor's overshoot, which a
     /// prediction within the coarse mesh's error does not have: on `stamp bench --problem
     /// sphere-displacement` at n = 80 the damped rules took 34 Newton iterations from the coarse

@@ -3,7 +3,7 @@
 //! * [`gmsh::read_msh`] reads a gmsh MSH 4.1 file (ASCII or binary) of triangles and
 //!   quadrilaterals (first or second order, cut into 4-node quadrilaterals) into a
 //!   [`crate::mesh::QuadMesh`] with its physical groups, checked as a whole
-//!   ([`crate::mesh_check`]); [`gmsh::parse_msh_bytes`] does the same from bytes;
+//!   ([`crate::mesh::check`]); [`gmsh::parse_msh_bytes`] does the same from bytes;
 //! * [`vtk::write_vtu`] writes a mesh with point and cell fields as a `.vtu` file, and
 //!   [`vtk::write_pvd`] the `.pvd` collection that lists them by load factor;
 //! * [`atomic::write_atomically`] makes every written file appear whole or not at all.

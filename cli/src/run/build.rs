@@ -76,7 +76,7 @@ pub struct Setup {
 /// onto the problem's mesh.
 pub struct CoarseSetup {
     pub setup: Setup,
-    pub prolongation: stamp::mesh_transfer::Prolongation,
+    pub prolongation: stamp::mesh::transfer::Prolongation,
 }
 
 fn face_of(f: PunchFace) -> Face {
@@ -185,7 +185,7 @@ fn build_coarse(p: &Problem, fine: &MeshData) -> Result<CoarseSetup> {
     }
     // the same plate: no node of the mesh farther outside the coarse one than a fifth of a coarse
     // cell (a curved edge meshed twice leaves its nodes a sagitta outside, l^2 / 8R)
-    let prolongation = stamp::mesh_transfer::Prolongation::between(&coarse.mesh, &fine.mesh);
+    let prolongation = stamp::mesh::transfer::Prolongation::between(&coarse.mesh, &fine.mesh);
     let (node, distance) = prolongation.farthest_outside();
     let allowed = 0.2 * coarse.element_size();
     if distance > allowed {
@@ -202,7 +202,7 @@ fn build_coarse(p: &Problem, fine: &MeshData) -> Result<CoarseSetup> {
     }
     // ... and the other way round: no node of the coarse mesh farther outside the mesh (a coarse
     // mesh of a larger plate covers the plate and more), and the same area
-    let (node, distance) = stamp::mesh_transfer::Prolongation::between(&fine.mesh, &coarse.mesh).farthest_outside();
+    let (node, distance) = stamp::mesh::transfer::Prolongation::between(&fine.mesh, &coarse.mesh).farthest_outside();
     if distance > allowed {
         return Err(p.error_at(
             span,

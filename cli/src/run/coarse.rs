@@ -1,16 +1,16 @@
 //! `[solver] predictor = "coarse"`: the problem is solved first on a coarse mesh (the rectangle
 //! with half its n, or `[mesh] coarse_file`), with the same load steps and settings, and every
 //! load step on the problem's mesh starts from that solution interpolated onto it
-//! ([`stamp::coarse_path`]). The coarse solve writes no files; summary.json's `coarse_predictor`
+//! ([`stamp::mesh::coarse_path`]). The coarse solve writes no files; summary.json's `coarse_predictor`
 //! and a line on stderr report what it cost. A coarse solve that fails leaves the steps beyond
 //! its last converged state to the secant predictor (the run goes on and says so). `stamp run
 //! --refine` starts each finer mesh from the run before it the same way ([`PreviousLevel`]).
 
 use super::build::{CoarseSetup, Setup};
 use serde::Serialize;
-use stamp::coarse_path::CoarsePath;
+use stamp::mesh::coarse_path::CoarsePath;
 use stamp::linalg::bordered::BorderedSolver;
-use stamp::mesh_transfer::Prolongation;
+use stamp::mesh::transfer::Prolongation;
 use stamp::mesh::QuadMesh;
 use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
 use std::sync::Arc;

@@ -111,13 +111,13 @@ impl MeshData {
         Ok(MeshData { mesh, points, curves, surfaces, node_tags: None, cell_tags: None, split: None })
     }
 
-    /// The uniform refinement of this mesh ([`stamp::mesh_refine`]: every cell into four at its edge
+    /// The uniform refinement of this mesh ([`stamp::mesh::refine`]: every cell into four at its edge
     /// midpoints and centre). Point groups keep their nodes, curves are cut at the midpoints of
     /// their segments, surfaces get the four children of each cell; the node groups of curves and
     /// points are rebuilt from those. New nodes have gmsh tag 0; a cell keeps the tag of the
     /// element it was cut from.
     pub fn refined(&self) -> MeshData {
-        let r = stamp::mesh_refine::refine(&self.mesh);
+        let r = stamp::mesh::refine::refine(&self.mesh);
         let curves: BTreeMap<String, Vec<[usize; 2]>> = self.curves.iter().map(|(k, s)| (k.clone(), r.segments(s))).collect();
         let surfaces = self.surfaces.iter().map(|(k, c)| (k.clone(), r.cells(c))).collect();
         let mut mesh = r.mesh.clone();

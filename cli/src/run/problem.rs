@@ -724,7 +724,7 @@ pub enum Predictor {
     #[default]
     Secant,
     /// The problem solved first on a coarse mesh (the rectangle with half its n, or
-    /// `mesh.coarse_file`), interpolated onto the mesh (stamp::coarse_path).
+    /// `mesh.coarse_file`), interpolated onto the mesh (stamp::mesh::coarse_path).
     Coarse,
 }
 

@@ -99,7 +99,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         eprintln!("warning: {w}");
     }
     // every refined model must fit before anything is solved
-    let sizes = stamp::mesh_refine::refined_sizes(&setup.mesh.mesh, levels);
+    let sizes = stamp::mesh::refine::refined_sizes(&setup.mesh.mesh, levels);
     check_levels_fit(&sizes, levels, super::memory::dofs_per_node(p.spec.plate.get_ref().surfaces), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
     // the folder is this run's until the last mesh is solved (the runs below claim it again)
@@ -246,7 +246,7 @@ mod tests {
         const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
         // 100 x 100 cells: 10201 nodes, 20200 edges; refined: 40401, 160801, 641601 nodes
         let mesh = stamp::mesh::QuadMesh::rectangle(0.0, 1.0, 0.0, 1.0, 100, 100).unwrap();
-        let sizes = stamp::mesh_refine::refined_sizes(&mesh, 3);
+        let sizes = stamp::mesh::refine::refined_sizes(&mesh, 3);
         assert_eq!(sizes.iter().map(|s| s.0).collect::<Vec<_>>(), [201 * 201, 401 * 401, 801 * 801]);
         // estimates: 1.44, 6.13 and 26.8 GiB
         assert!(check_levels_fit(&sizes, 3, 6, Some(64.0 * GIB)).is_ok());

@@ -6,7 +6,7 @@
 //!   quadrilaterals, 2- and 3-node lines, points) and how surface elements are cut into 4-node
 //!   quadrilaterals;
 //! * this file: nodes, cells and physical groups put together, orientation, and the mesh checked as
-//!   a whole ([`crate::mesh_check`]) with messages that name gmsh tags.
+//!   a whole ([`crate::mesh::check`]) with messages that name gmsh tags.
 //!
 //! The plate lies in the x1-x2 plane (every z must be 0). A mesh whose cells are all clockwise
 //! (surface normal along -z) is reoriented; a mixture of orientations is an error.
@@ -16,7 +16,7 @@ mod sections;
 
 use crate::error::{Result, StampError};
 use crate::mesh::{quad_signed_area, QuadMesh};
-use crate::mesh_check::{self, Defect};
+use crate::mesh::check::{self as mesh_check, Defect};
 use elements::{NewNodes, NodeRef};
 use sections::{input_err, RawMsh};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -239,7 +239,7 @@ struct SurfaceElement {
 /// Surface elements of the accepted types (3- and 6-node triangles, 4-, 8- and 9-node
 /// quadrilaterals) are cut into 4-node quadrilaterals (see the `elements` module); 2- and 3-node
 /// lines give 2-node segments of curve groups (a line whose edge got a midpoint is cut in two), and
-/// points give point groups. The mesh is then checked as a whole ([`crate::mesh_check`]). Every
+/// points give point groups. The mesh is then checked as a whole ([`crate::mesh::check`]). Every
 /// failure is a [`StampError::Input`] naming the file and the gmsh tags concerned; nothing in the
 /// bytes can make it panic or allocate beyond what the bytes can hold.
 pub fn parse_msh_bytes(path: &Path, bytes: &[u8]) -> Result<GmshMesh> {

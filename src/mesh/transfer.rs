@@ -8,7 +8,7 @@
 //! nearest point of the cell for a parallelogram; close to it for the cells a mesh generator
 //! makes). [`Prolongation::farthest_outside`] says how far outside the farthest node lies.
 //!
-//! Used by [`crate::coarse_path`] to start the load steps of a fine mesh from the solution on a
+//! Used by [`crate::mesh::coarse_path`] to start the load steps of a fine mesh from the solution on a
 //! coarse one.
 
 use crate::mesh::{bilinear, bilinear_point, inverse_bilinear, QuadMesh};
@@ -131,7 +131,7 @@ mod tests {
                 x[1] += 0.2 * ((k as f64) * 0.7).cos();
             }
         }
-        let fine = crate::mesh_refine::refine(&coarse).mesh;
+        let fine = crate::mesh::refine::refine(&coarse).mesh;
         let field = |p: [f64; 2]| [1.0 + 2.0 * p[0] - 3.0 * p[1], -0.5 * p[0] + 0.25 * p[1]];
         let coarse_values: Vec<f64> = coarse.coords.iter().flat_map(|&p| field(p)).chain([7.0]).collect();
         let mut fine_values = vec![0.0; fine.num_nodes() * 2 + 1];

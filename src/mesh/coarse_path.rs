@@ -5,7 +5,7 @@
 //! predicted a free plate's increment deep inside the punch, and the active set has to walk there
 //! ring by ring. The same problem solved first on a coarse mesh (a quarter of the unknowns for a
 //! mesh with half the element size) knows where the rim goes; its solution interpolated onto the
-//! fine mesh ([`crate::mesh_transfer::Prolongation`]) starts each fine step within the coarse
+//! fine mesh ([`crate::mesh::transfer::Prolongation`]) starts each fine step within the coarse
 //! mesh's discretisation error of the answer. Measured on `stamp bench --problem
 //! sphere-displacement` (docs/performance.md).
 //!
@@ -14,7 +14,7 @@
 //! path's length (sum of |dt|) between the two coarse states around it, so a fine path with other
 //! step sizes or cut-backs, going up and down, is predicted all the same.
 
-use crate::mesh_transfer::Prolongation;
+use crate::mesh::transfer::Prolongation;
 
 /// The converged states of a coarse path and the map onto the fine mesh.
 pub struct CoarsePath {
@@ -91,7 +91,7 @@ mod tests {
     #[test]
     fn follows_the_coarse_path_up_and_down() {
         let coarse = QuadMesh::rectangle(0.0, 2.0, 0.0, 1.0, 2, 1).unwrap();
-        let fine = crate::mesh_refine::refine(&coarse).mesh;
+        let fine = crate::mesh::refine::refine(&coarse).mesh;
         let field = |mesh: &QuadMesh, t: f64| mesh.coords.iter().map(|p| t * p[0]).collect::<Vec<f64>>();
         let mut path = CoarsePath::new(Prolongation::between(&coarse, &fine), 1);
         for t in [0.0, 0.5, 1.0, 0.5] {

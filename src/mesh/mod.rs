@@ -1,6 +1,14 @@
 //! Plane quadrilateral meshes: node coordinates in the reference plane (x1, x2), four-node cells
 //! numbered counter-clockwise, and named groups of nodes and cells (gmsh physical groups, or groups a
-//! program defines). The mesh knows nothing about what is solved on it.
+//! program defines). The mesh knows nothing about what is solved on it. Beside it: [`check`]
+//! (defects of a mesh), [`refine`] (every cell into four), [`transfer`] (a field from one mesh onto
+//! another by point location) and [`coarse_path`] (a coarse mesh's solution along the load path,
+//! the coarse predictor's).
+
+pub mod check;
+pub mod coarse_path;
+pub mod refine;
+pub mod transfer;
 
 use crate::error::{Result, StampError};
 use std::collections::BTreeMap;
@@ -141,14 +149,7 @@ impl QuadMesh {
             let x = self.cell_coords(c);
             for &(s, t) in &[(-g, -g), (g, -g), (g, g), (-g, g)] {
                 let (n, dn) = bilinear(s, t);
-                let mut j = [[0.0; 2]; 2];
-                for a in 0..4 {
-                    for d in 0..2 {
-                        j[d][0] += x[a][d] * dn[a][0];
-                        j[d][1] += x[a][d] * dn[a][1];
-                    }
-                }
-                let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+                let det = bilinear_jacobian(&x, &dn);
                 for a in 0..4 {
                     w[cell[a]] += n[a] * det;
                 }
@@ -185,6 +186,19 @@ impl QuadMesh {
         mesh.cell_groups.insert("all".into(), (0..nx * ny).collect());
         Ok(mesh)
     }
+}
+
+/// The Jacobian determinant of the bilinear map of the cell with corners `x` at a point where the
+/// shape functions' derivatives are `dn` (see [`bilinear`]).
+pub fn bilinear_jacobian(x: &[[f64; 2]], dn: &[[f64; 2]; 4]) -> f64 {
+    let mut j = [[0.0; 2]; 2];
+    for a in 0..4 {
+        for d in 0..2 {
+            j[d][0] += x[a][d] * dn[a][0];
+            j[d][1] += x[a][d] * dn[a][1];
+        }
+    }
+    j[0][0] * j[1][1] - j[0][1] * j[1][0]
 }
 
 /// Bilinear shape functions and their derivatives with respect to (xi1, xi2) on [-1, 1]^2, nodes
