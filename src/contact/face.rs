@@ -17,7 +17,7 @@
 //! is the contact force there. The penalty energy sum_i A_i (lambda_i^2 / (2 eps)) has this force
 //! as its gradient, so the tangent is symmetric: eps / A_i a_i a_i^T (a_i = A_i dg_i/du) plus
 //! int lambda_h N_j N_k H dA. Since a_i reaches every node of node i's cells, the tangent couples
-//! the nodes of two cells that share a node: [`ContactFace::patches`] lists them for the sparse
+//! the nodes of two cells that share a node: [`ContactFace::patch`] lists them for the sparse
 //! pattern.
 //!
 //! The nodal collocation of the paper (eq. 3.8 at the nodes, tributary weights) is the same
@@ -129,12 +129,6 @@ impl ContactFace {
     /// Number of contact points.
     pub fn num_points(&self) -> usize {
         self.area.len()
-    }
-
-    /// Every contact point's patch ([`patch`](Self::patch)): the groups of points whose dofs the
-    /// tangent couples.
-    pub fn patches(&self) -> impl Iterator<Item = &[u32]> + '_ {
-        (0..self.num_points()).map(|i| self.patch(i))
     }
 }
 

@@ -257,16 +257,6 @@ impl SiteContext<'_> {
     }
 }
 
-/// How the constraint is discretised over the body's face.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ContactDiscretisation {
-    /// Psi at each node, weighted by its tributary area (the paper's collocation, eq. 3.8).
-    #[default]
-    Nodal,
-    /// The weighted gap of each node integrated over its cells ([`ContactFace`]).
-    Integrated,
-}
-
 /// The default [`ContactPair::entry_fraction`].
 pub const ENTRY_FRACTION: f64 = 0.5;
 
@@ -347,11 +337,6 @@ impl ContactPair {
         self.surface_at_points = vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; face.quadrature.len()];
         self.face = Some(face);
         Ok(self)
-    }
-
-    /// The discretisation of the constraint.
-    pub fn discretisation(&self) -> ContactDiscretisation {
-        if self.face.is_some() { ContactDiscretisation::Integrated } else { ContactDiscretisation::Nodal }
     }
 
     /// The integrated discretisation's face, if any.
@@ -698,6 +683,11 @@ impl ContactPair {
         changes
     }
 
+    /// The multiplier field lambda_h = sum_a N_a lambda_a at a quadrature point of the face.
+    fn traction_at(&self, q: &face::FacePoint) -> f64 {
+        (0..4).map(|a| q.shape[a] * self.state[q.points[a] as usize].lambda).sum()
+    }
+
     /// The integrated discretisation's forces and tangent (see [`ContactFace`]) from the
     /// multipliers in `state` and the kinematics `sites` of the quadrature points: at each
     /// quadrature point lambda_q = sum_a N_a lambda_a, the force w_q lambda_q N_j grad Psi on its
@@ -708,7 +698,7 @@ impl ContactPair {
         let face = self.face.as_ref().expect("integrated");
         let drive = self.drive;
         for (q, site) in face.quadrature.iter().zip(sites) {
-            let lambda_q: f64 = (0..4).map(|a| q.shape[a] * self.state[q.points[a] as usize].lambda).sum();
+            let lambda_q = self.traction_at(q);
             if lambda_q == 0.0 {
                 continue;
             }
@@ -881,7 +871,7 @@ impl ContactPair {
         };
         let mut f = vec![Vector3::zeros(); self.points.len()];
         for (q, site) in face.quadrature.iter().zip(&self.site_scratch) {
-            let lambda_q: f64 = (0..4).map(|a| q.shape[a] * self.state[q.points[a] as usize].lambda).sum();
+            let lambda_q = self.traction_at(q);
             for a in 0..4 {
                 f[q.points[a] as usize] += site.1 * (q.weight * lambda_q * q.shape[a]);
             }
