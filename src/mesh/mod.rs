@@ -139,6 +139,12 @@ impl QuadMesh {
         (0..self.coords.len()).filter(|&i| pred(self.coords[i])).collect()
     }
 
+    /// Characteristic element size: the square root of the mean cell area.
+    pub fn element_size(&self) -> f64 {
+        let total: f64 = self.nodal_areas().iter().sum();
+        (total / self.num_cells().max(1) as f64).sqrt()
+    }
+
     /// Tributary (lumped) area of every node: each cell gives a quarter of its integral of the
     /// bilinear shape function of that node (exact for the bilinear element, one quarter of the area
     /// per node on a parallelogram).

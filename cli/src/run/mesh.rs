@@ -191,8 +191,7 @@ impl MeshData {
 
     /// Characteristic element size: the square root of the mean cell area.
     pub fn element_size(&self) -> f64 {
-        let total: f64 = self.mesh.nodal_areas().iter().sum();
-        (total / self.mesh.num_cells() as f64).sqrt()
+        self.mesh.element_size()
     }
 
     /// The nodes of a curve group in chain order with their arc length from the chain's start (for

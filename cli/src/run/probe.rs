@@ -174,7 +174,7 @@ impl ProbeLine {
         let len = (to[0] - from[0]).hypot(to[1] - from[1]);
         let dir = [(to[0] - from[0]) / len, (to[1] - from[1]) / len];
         let tol = 1e-9 * len;
-        let width = BAND_CELLS * (mesh.nodal_areas().iter().sum::<f64>() / mesh.num_cells().max(1) as f64).sqrt();
+        let width = BAND_CELLS * mesh.element_size();
         let mut samples: Vec<Sample> = Vec::new();
         let mut add = |distance: f64, x: [f64; 2]| {
             if let Some((c, xi)) = locator.locate(x) {
