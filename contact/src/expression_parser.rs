@@ -354,19 +354,7 @@ mod tests {
         assert!(col(&minus).1.contains("nests deeper"));
     }
 
-    /// xorshift64*: the same inputs on every run.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-        }
-        fn below(&mut self, n: usize) -> usize {
-            (self.next() % n.max(1) as u64) as usize
-        }
-    }
+    use crate::test_rng::Rng;
 
     #[test]
     fn hundreds_of_random_and_mutated_expressions_give_a_tree_or_an_error_never_a_panic() {

@@ -18,6 +18,8 @@ pub mod jet;
 mod plane;
 mod sphere;
 pub mod stl;
+#[cfg(test)]
+mod test_rng;
 
 pub use cylinder::Cylinder;
 pub use expression::Expression;
