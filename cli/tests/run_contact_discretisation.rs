@@ -71,7 +71,7 @@ motion = [0.0, 0.0, -3.0]
 [solver]
 steps = 2
 [output]
-plot = false
+plot = true
 [[output.probe]]
 name = "across"
 from = [50.0, 30.0]
@@ -99,6 +99,15 @@ fn a_line_contact_is_reported_narrower_than_the_cells_and_a_probe_reads_its_load
     assert!((last[7] - per_length).abs() < 0.04 * per_length, "integral {} against {per_length}", last[7]);
     // the band is 8 cells (32) wide here: it averages the rise towards the free edges in
     assert!((last[8] - per_length).abs() < 0.08 * per_length, "band {} against {per_length}", last[8]);
+    // the probe plot's title (a second line under the first) gives both integrals
+    let svg = std::fs::read_to_string(p.with_extension("out").join("probe_across.svg")).unwrap();
+    assert!(svg.contains("contact pressure along probe &apos;across&apos;"), "{svg}");
+    let line = svg.split("at the last step its integral is ").nth(1).and_then(|t| t.split('<').next()).map(str::trim).expect("the title's second line");
+    let numbers: Vec<f64> = line.split(|c: char| c == ' ' || c == '(').filter_map(|w| w.parse().ok()).collect();
+    assert!(line.ends_with("across a band of 8 cells)") && numbers.len() == 3, "{line}");
+    for (shown, exact) in [(numbers[0], last[7]), (numbers[1], last[8])] {
+        assert!((shown - exact).abs() <= 1e-3 * exact, "{line}: {shown} against {exact}");
+    }
     // a sphere on a plate presses a disc: no warning
     let (ok, err, s) = run(&variant("sphere-wide", "sphere-ss.toml", &[]));
     assert!(ok && !err.contains("narrower"), "{err}");

@@ -30,6 +30,7 @@ pub struct Series {
 
 /// A plot description.
 pub struct Plot<'a> {
+    /// One line, or several separated by '\n'.
     pub title: &'a str,
     pub x_label: &'a str,
     pub y_label: &'a str,
@@ -94,7 +95,11 @@ where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let area = root.titled(p.title, (FONT_NAME, 22)).map_err(|e| e.to_string())?;
+    // a title of several lines: each its own line, the first in the larger font
+    let mut area = root.clone();
+    for (k, line) in p.title.lines().enumerate() {
+        area = area.titled(line, (FONT_NAME, if k == 0 { 22 } else { 18 })).map_err(|e| e.to_string())?;
+    }
     let lw = legend_width(p);
     let (plot_area, legend_area) = area.split_horizontally(WIDTH - lw);
     let (x0, x1) = range(p.series.iter().flat_map(|s| s.points.iter().chain(&s.markers).map(|q| q.0)));

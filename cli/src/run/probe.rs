@@ -424,7 +424,7 @@ impl<'a> Probes<'a> {
             let [a, b] = [line.from, line.to].map(|p| format!("({}, {})", sig4(p[0]), sig4(p[1])));
             let end = curves.last().expect("not empty");
             let title = format!(
-                "contact pressure along probe '{}' from {a} to {b}; at the last step its integral is {} ({} across a band of {} cells)",
+                "contact pressure along probe '{}' from {a} to {b}\nat the last step its integral is {} ({} across a band of {} cells)",
                 line.name,
                 sig4(end.integral),
                 sig4(end.line_load),
