@@ -22,7 +22,7 @@ use stamp::model::Model;
 use stamp::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearProblem, NonlinearSolver};
 use stamp::{Result, StampError};
 use stamp_contact::Sphere;
-use crate::run::plate_model::Plate;
+use stamp_problem::plate_model::Plate;
 use stamp_elements::{Face, Isotropic, Kinematics, PlateElements, Section};
 use std::sync::Arc;
 use std::time::Instant;
@@ -213,14 +213,14 @@ pub struct SolverOptions {
 
 /// The model, the load targets and the settings of `meshes/sphere-ss-displacement.toml` on an
 /// n x n mesh, built as `stamp run` builds them.
-fn build_displacement(n: usize, predictor: BenchPredictor) -> Result<(crate::run::build::Setup, Vec<f64>)> {
+fn build_displacement(n: usize, predictor: BenchPredictor) -> Result<(stamp_problem::build::Setup, Vec<f64>)> {
     debug_assert!(DISPLACEMENT_PROBLEM.contains(DISPLACEMENT_MESH_N));
     let mut source = DISPLACEMENT_PROBLEM.replacen(DISPLACEMENT_MESH_N, &format!("n = [{n}, {n}]"), 1);
     if predictor == BenchPredictor::Coarse {
         source = source.replacen(DISPLACEMENT_SOLVER, &format!("{DISPLACEMENT_SOLVER}predictor = \"coarse\"\n"), 1);
     }
-    let p = crate::run::Problem::parse(std::path::Path::new("meshes/sphere-ss-displacement.toml"), source)?;
-    let setup = crate::run::build::build(&p)?;
+    let p = stamp_problem::Problem::parse(std::path::Path::new("meshes/sphere-ss-displacement.toml"), source)?;
+    let setup = stamp_problem::build::build(&p)?;
     let targets = setup.targets.clone();
     Ok((setup, targets))
 }
@@ -241,7 +241,7 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
             if options.predictor == BenchPredictor::Coarse && setup.coarse.is_none() {
                 return Err(StampError::Problem("--predictor coarse: the problem file's [solver] table was not found to add predictor = \"coarse\"".into()));
             }
-            let coarse = setup.coarse.map(|c| crate::run::coarse::solve_coarse(*c, &targets));
+            let coarse = setup.coarse.map(|c| stamp_problem::coarse::solve_coarse(*c, &targets));
             (setup.model, setup.mesh.mesh, setup.settings, targets, coarse)
         }
     };
@@ -252,7 +252,7 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
             if let Some(e) = &report.error {
                 return Err(StampError::Problem(format!("the coarse solve of predictor = \"coarse\" failed: {e}")));
             }
-            crate::run::coarse::predict_from(&mut newton, path);
+            stamp_problem::coarse::predict_from(&mut newton, path);
             Some(CoarseRun { unknowns: report.equations, steps: report.steps, newton_iterations: report.newton_iterations, seconds: report.seconds })
         }
         None => None,

@@ -98,8 +98,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         None => stamp_cli::paper::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
-        Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::run::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
-        Some(Command::Check { problem }) => stamp_cli::run::check_command(&problem),
+        Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::commands::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
+        Some(Command::Check { problem }) => stamp_cli::commands::check_command(&problem),
         Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, predictor, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor }),
         Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, predictor, one: None }) => {
             let sizes = sizes.unwrap_or_else(|| problem.default_sizes().to_vec());

@@ -9,7 +9,7 @@ use stamp_cli::run::{build::build, Problem};
 #[test]
 fn cantilever_roll_example_follows_the_exact_circles_and_closes_at_full_load() {
     let path = repo().join("meshes/cantilever-roll.toml");
-    stamp_cli::run::check_command(&path).unwrap();
+    stamp_cli::commands::check_command(&path).unwrap();
     let out = temp_dir("cantilever-roll");
     stamp_cli::run::run(&path, Some(&out), true).unwrap();
     let s = summary(&out);

@@ -2,7 +2,7 @@
 //! several loads (R = 100, nonlinear), as PNG, SVG and the CSV of the plotted points.
 
 use super::strip::{solve_strip, StripProblem};
-use crate::run::plot::{write_plot, Plot, Series};
+use stamp_problem::plot::{write_plot, Plot, Series};
 use stamp::io::write_string_atomically;
 use stamp::StampError;
 use stamp_elements::Kinematics;

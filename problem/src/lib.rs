@@ -1,4 +1,6 @@
-//! `stamp run`: problem files, the generic solve pipeline and its outputs.
+//! stamp's problem files as a library: read, build, check, solve and write the problem a TOML
+//! file (or the same table built in memory) describes. The `stamp` program (`stamp run`,
+//! `stamp check`) and the Python package are thin shells around it.
 //!
 //! * [`problem`]: the TOML schema (serde, `deny_unknown_fields`) and its checks; it depends on no
 //!   module below but [`units`] (the modules that build and run the model read it, not the reverse);
@@ -14,7 +16,7 @@
 //! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step;
 //! * [`refine`]: `stamp run --refine`, the run on refined meshes, with [`richardson`] and
 //!   [`refine_report`] (the estimates in the table, history.csv and summary.json);
-//! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in [`crate::paper`]).
+//! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in the CLI).
 
 pub mod abort_note;
 pub mod build;
@@ -45,6 +47,7 @@ pub mod solve;
 pub mod table;
 pub mod travel_modes;
 pub mod units;
+pub mod stdout;
 
 pub use problem::Problem;
 pub use solve::{default_out_dir, RunOutcome};
@@ -71,59 +74,19 @@ pub fn run(problem: &Path, out: Option<&Path>, quiet: bool) -> stamp::Result<Run
     outcome
 }
 
-/// `stamp check`: read and build the problem file, run the checks, print the model's summary on
-/// stdout and the warnings on stderr; an error is returned as it is.
-pub fn check_command(problem: &Path) -> stamp::Result<()> {
-    let p = Problem::read(problem)?;
-    let setup = build::build(&p)?;
-    let report = check::check(&p, &setup)?;
-    crate::outln!("{}", report.summary);
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
-    }
-    crate::outln!("check: no errors{}", match report.warnings.len() {
-        0 => String::new(),
-        1 => ", 1 warning".into(),
-        n => format!(", {n} warnings"),
-    });
-    Ok(())
-}
-
-/// Run the problem file `problem`, writing into `out`; with `refine` = Some(levels) also on the mesh
-/// refined `levels` times (see [`refine`]).
-pub fn run_command(problem: &Path, out: Option<&Path>, quiet: bool, refine: Option<usize>) -> stamp::Result<()> {
-    let outcome = match refine {
-        None => run(problem, out, quiet)?,
-        Some(levels) => refine::run_refined(problem, out, quiet, levels)?,
-    };
-    if !quiet {
-        let refined = match refine {
-            Some(1) => format!("; the refined mesh's in {}", outcome.out_dir.join(refine::level_folder(1)).display()),
-            Some(n) => format!("; the refined meshes' in {} ... {}", outcome.out_dir.join(refine::level_folder(1)).display(), refine::level_folder(n)),
-            None => String::new(),
-        };
-        crate::outln!(
-            "stamp run: {} converged steps; results in {} (summary.json, .pvd/.vtu, CSV){refined}",
-            outcome.converged_steps,
-            outcome.out_dir.display()
-        );
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use std::collections::BTreeMap;
 
     /// Each module of this folder and the modules of this folder its code names (`super::x`,
-    /// `crate::run::x`; comments left out).
+    /// `crate::x`; comments left out).
     fn uses() -> BTreeMap<String, Vec<String>> {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/run");
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
         let mut graph = BTreeMap::new();
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
             let Some(name) = path.file_stem().and_then(|s| s.to_str()).filter(|_| path.extension().is_some_and(|e| e == "rs")) else { continue };
-            if name == "mod" {
+            if name == "lib" || name == "stdout" {
                 continue;
             }
             let text = std::fs::read_to_string(&path).unwrap();
@@ -131,7 +94,7 @@ mod tests {
             let code = text.split("#[cfg(test)]").next().unwrap();
             let mut deps: Vec<String> = Vec::new();
             for line in code.lines().map(str::trim).filter(|l| !l.starts_with("//")) {
-                for prefix in ["super::", "crate::run::"] {
+                for prefix in ["super::", "crate::"] {
                     for part in line.split(prefix).skip(1) {
                         let dep: String = part.chars().take_while(|c| c.is_ascii_lowercase() || *c == '_').collect();
                         if !dep.is_empty() && !deps.contains(&dep) {

@@ -78,7 +78,7 @@ pub fn render_columns(cols: &[Column]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::history::{HistoryRow, PunchRow};
+    use crate::history::{HistoryRow, PunchRow};
     use stamp_elements::Face;
 
     #[test]

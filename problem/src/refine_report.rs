@@ -262,7 +262,7 @@ pub fn percent(p: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::history::PunchRow;
+    use crate::history::PunchRow;
     use stamp_elements::Face;
 
     fn history(rows: &[(f64, f64, f64)]) -> History {
