@@ -918,6 +918,9 @@ pub struct Problem {
     pub path: PathBuf,
     pub source: String,
     pub spec: ProblemFile,
+    /// A mesh given in memory (the Python package's arrays, [`stamp::io::mesh_from_arrays`]) in
+    /// place of `[mesh] file` or `rectangle`.
+    pub given_mesh: Option<std::sync::Arc<stamp::io::GmshMesh>>,
 }
 
 impl Problem {
@@ -949,8 +952,22 @@ impl Problem {
         Problem::parse(path, source)
     }
 
+    /// The problem of a table built in memory (the Python package's dict), with the same schema,
+    /// checks and messages as a file: the table is written as TOML (the text errors point into,
+    /// [`Problem::source`]) and parsed as a file named `path` would be, relative paths starting
+    /// in the folder of `path`. `mesh`, if given, takes the place of `[mesh] file` or `rectangle`
+    /// (the table's `mesh` then has neither).
+    pub fn from_table(path: &Path, table: toml::Table, mesh: Option<stamp::io::GmshMesh>) -> Result<Problem> {
+        let source = toml::to_string(&table).map_err(|e| StampError::Input { file: path.display().to_string(), message: format!("cannot be written as TOML: {e}") })?;
+        Problem::parse_with_mesh(path, source, mesh.map(std::sync::Arc::new))
+    }
+
     /// Parse problem text (`path` names it in errors and anchors relative paths).
     pub fn parse(path: &Path, source: String) -> Result<Problem> {
+        Problem::parse_with_mesh(path, source, None)
+    }
+
+    fn parse_with_mesh(path: &Path, source: String, given_mesh: Option<std::sync::Arc<stamp::io::GmshMesh>>) -> Result<Problem> {
         if source.trim_start().starts_with("$MeshFormat") {
             return Err(StampError::Input {
                 file: path.display().to_string(),
@@ -958,7 +975,7 @@ impl Problem {
             });
         }
         let spec: ProblemFile = toml::from_str(&source).map_err(|e| StampError::Input { file: path.display().to_string(), message: toml_message(&source, &e) })?;
-        let p = Problem { path: path.to_path_buf(), source, spec };
+        let p = Problem { path: path.to_path_buf(), source, spec, given_mesh };
         p.check()?;
         Ok(p)
     }
@@ -994,6 +1011,19 @@ impl Problem {
     fn check(&self) -> Result<()> {
         let s = &self.spec;
         let mesh = s.mesh.get_ref();
+        let coarse = s.solver.predictor.as_ref().filter(|k| *k.get_ref() == Predictor::Coarse);
+        if self.given_mesh.is_some() {
+            if mesh.file.is_some() || mesh.rectangle.is_some() {
+                return Err(self.error_at(s.mesh.span(), "mesh", "give the mesh as arrays (`nodes`, `cells`) or as `file` or `rectangle`, not both"));
+            }
+            if let Some(f) = &mesh.coarse_file {
+                return Err(self.error_at(f.span(), "mesh.coarse_file", "belongs to a gmsh `file`, not to a mesh given as arrays"));
+            }
+            if let Some(k) = coarse {
+                return Err(self.error_at(k.span(), "solver.predictor", "\"coarse\" needs a coarse mesh of the same plate: give the mesh as `rectangle`, or as a gmsh `file` with `coarse_file`"));
+            }
+            return self.check_rest();
+        }
         if mesh.file.is_some() == mesh.rectangle.is_some() {
             return Err(self.error_at(s.mesh.span(), "mesh", "give exactly one of `file` (a gmsh .msh) and `rectangle`"));
         }
@@ -1005,7 +1035,6 @@ impl Problem {
                 return Err(self.error_at(s.mesh.span(), "mesh.rectangle.n", format!("needs at least one cell each way, got {:?}", r.n)));
             }
         }
-        let coarse = s.solver.predictor.as_ref().filter(|k| *k.get_ref() == Predictor::Coarse);
         match (&mesh.rectangle, &mesh.coarse_file, coarse) {
             (Some(_), Some(f), _) => {
                 return Err(self.error_at(f.span(), "mesh.coarse_file", "belongs to a gmsh `file`: with `rectangle`, predictor = \"coarse\" halves its n"));
@@ -1025,6 +1054,12 @@ impl Problem {
             }
             _ => {}
         }
+        self.check_rest()
+    }
+
+    /// The checks after the mesh's.
+    fn check_rest(&self) -> Result<()> {
+        let s = &self.spec;
         let plate = s.plate.get_ref();
         match (plate.thickness, plate.delta_minus, plate.delta_plus) {
             (Some(_), None, None) => {}
