@@ -825,7 +825,16 @@ fn toml_message(source: &str, e: &toml::de::Error) -> String {
         ),
         None => what,
     };
-    let what = match key_at(source, line, col) {
+    // an unknown key: toml points at the key itself, which the message names; its table is named
+    // before it ("punch[0]: unknown field `radios`")
+    let unknown_key = || {
+        let text = source.lines().nth(line.checked_sub(1)?)?;
+        let eq = text.chars().skip(col.saturating_sub(1)).position(|c| c == '=')?;
+        let key = key_at(source, line, col + eq + 1)?;
+        key.rsplit_once('.').map(|(table, _)| table.to_string())
+    };
+    let key = if what.starts_with("unknown field") { unknown_key() } else { key_at(source, line, col) };
+    let what = match key {
         // our own checks may name the key already ("mesh.rectangle.n: ...")
         Some(key) if !what.starts_with(&key) => format!("{}: {what}", quote(&key)),
         _ => what,
