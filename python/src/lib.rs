@@ -92,10 +92,14 @@ impl NativeProblem {
         match outcome {
             Ok(outcome) => NativeResult::new(outcome, temp),
             Err(e @ stamp::StampError::Interrupted { .. }) => {
-                // Python's own handler ran too (chained): its KeyboardInterrupt comes first
-                py.check_signals()?;
-                let by = if interrupted { " by Ctrl-C" } else { "" };
-                Err(PyKeyboardInterrupt::new_err(format!("{e}{by}")))
+                // Python's own handler ran too (chained): what it raises comes first, a
+                // KeyboardInterrupt with the library's message
+                let by = if interrupted { " (Ctrl-C)" } else { "" };
+                let message = format!("{e}{by}");
+                match py.check_signals() {
+                    Err(raised) if !raised.is_instance_of::<PyKeyboardInterrupt>(py) => Err(raised),
+                    _ => Err(PyKeyboardInterrupt::new_err(message)),
+                }
             }
             Err(e) => Err(to_py(e)),
         }
