@@ -1293,3 +1293,46 @@ impl Problem {
         self.path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p }).unwrap_or(Path::new(".")).to_path_buf()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = "[mesh]\nrectangle = { x = [0.0, 1.0], y = [0.0, 1.0], n = [2, 2] }\n\n[plate]\nthickness = 0.1\nE = 1.0\nnu = 0.3\n";
+
+    fn table(text: &str) -> toml::Table {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn a_table_is_read_as_its_file_is() {
+        let file = Problem::parse(Path::new("p.toml"), TEXT.into()).unwrap();
+        let built = Problem::from_table(Path::new("p.toml"), table(TEXT), None).unwrap();
+        assert_eq!(format!("{:?}", built.spec.plate.get_ref()), format!("{:?}", file.spec.plate.get_ref()));
+        assert_eq!(format!("{:?}", built.spec.mesh.get_ref().rectangle), format!("{:?}", file.spec.mesh.get_ref().rectangle));
+        // the same message, but for the line, which is the written table's
+        let bad = TEXT.replace("nu = 0.3", "nu = 0.7");
+        let from_file = Problem::parse(Path::new("p.toml"), bad.clone()).unwrap_err().to_string();
+        let from_table = Problem::from_table(Path::new("p.toml"), table(&bad), None).unwrap_err().to_string();
+        let what = |m: &str| m.split_once("plate.nu: ").map(|(_, w)| w.lines().next().unwrap().to_string()).unwrap();
+        assert_eq!(what(&from_table), what(&from_file));
+        assert_eq!(what(&from_file), "expected Poisson's ratio in (-1, 0.5), got 0.7");
+    }
+
+    #[test]
+    fn a_given_mesh_takes_the_place_of_file_and_rectangle() {
+        let nodes = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let mesh = || Some(stamp::io::mesh_from_arrays(Path::new("mesh"), &nodes, &[vec![0, 1, 2, 3]], &[]).unwrap());
+        let given = TEXT.replace("rectangle = { x = [0.0, 1.0], y = [0.0, 1.0], n = [2, 2] }\n", "");
+        let p = Problem::from_table(Path::new("p"), table(&given), mesh()).unwrap();
+        assert_eq!(p.given_mesh.as_ref().unwrap().mesh.num_cells(), 1);
+        let both = Problem::from_table(Path::new("p"), table(TEXT), mesh()).unwrap_err().to_string();
+        assert!(both.contains("mesh: give the mesh as arrays (`nodes`, `cells`) or as `file` or `rectangle`, not both"), "{both}");
+        let coarse = format!("{given}\n[solver]\npredictor = \"coarse\"\n");
+        let e = Problem::from_table(Path::new("p"), table(&coarse), mesh()).unwrap_err().to_string();
+        assert!(e.contains("solver.predictor: \"coarse\" needs a coarse mesh"), "{e}");
+        // without the mesh the table is a file without a mesh
+        let e = Problem::from_table(Path::new("p"), table(&given), None).unwrap_err().to_string();
+        assert!(e.contains("give exactly one of `file` (a gmsh .msh) and `rectangle`"), "{e}");
+    }
+}
