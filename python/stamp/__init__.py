@@ -106,7 +106,9 @@ class Problem:
     checked as a gmsh file is (orientation, overlaps, hanging nodes). Errors about the arrays name
     the row.
 
-    ``name`` names the problem in messages and its output files (``name_0001.vtu``).
+    ``name`` names the problem in messages and its output files (``name_0001.vtu``); relative
+    paths in the table (a mesh ``file``, an STL punch's ``file``) start in its folder, the working
+    directory for a plain name.
     """
 
     def __init__(self, table, *, name="problem"):
