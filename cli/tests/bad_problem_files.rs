@@ -384,3 +384,14 @@ fn every_shipped_problem_file_passes_the_checks() {
         }
     }
 }
+
+#[test]
+fn an_unknown_key_is_named_with_its_table() {
+    // toml points at the key itself, which its message names: the table is named before it (and
+    // the inline table it sits in), not the key before it
+    let text = format!("{BASE}{PUNCH}radios = 3\n");
+    let err = refused("unknown_punch_key", &text, Some("radios = 3"), &["punch[0]: unknown field `radios`"]);
+    assert!(!err.contains("punch[0].motion"), "{err}");
+    let text = format!("{BASE}{PUNCH}").replace("[plate]", "[plate]\npoisson = 0.3");
+    refused("unknown_plate_key", &text, Some("poisson = 0.3"), &["plate: unknown field `poisson`"]);
+}

@@ -149,9 +149,11 @@ pub fn build(p: &Problem) -> Result<Setup> {
     // a gmsh mesh is read first (its size bounded by its file); refuse it before the model is built,
     // and a rectangle (checked for the paper's plate when read) too if the plate has more unknowns
     let dofs_per_node = super::memory::dofs_per_node(s.plate.get_ref().surfaces);
+    let fits = super::memory::check_problem_fits(&stl_dies(p), mesh.mesh.num_nodes() as u64, dofs_per_node);
     match &s.mesh.get_ref().file {
-        Some(file) => super::memory::check_problem_fits(&stl_dies(p), mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(file.span(), "mesh.file", m))?,
-        None => super::memory::check_problem_fits(&stl_dies(p), mesh.mesh.num_nodes() as u64, dofs_per_node).map_err(|m| p.error_at(s.mesh.span(), "mesh.rectangle", m))?,
+        _ if p.given_mesh.is_some() => fits.map_err(|m| p.error_at(s.mesh.span(), "mesh.nodes", m))?,
+        Some(file) => fits.map_err(|m| p.error_at(file.span(), "mesh.file", m))?,
+        None => fits.map_err(|m| p.error_at(s.mesh.span(), "mesh.rectangle", m))?,
     }
     let mut setup = build_on(p, mesh)?;
     if s.solver.predictor.as_ref().is_some_and(|k| *k.get_ref() == Predictor::Coarse) {

@@ -504,12 +504,12 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
     if let Some(t) = &s.title {
         let _ = writeln!(o, "title: {}", quote(t));
     }
-    let source = match &s.mesh.get_ref().file {
-        Some(f) => format!("gmsh file {}", quote(f.get_ref())),
-        None => {
-            let r = s.mesh.get_ref().rectangle.as_ref().unwrap();
-            format!("rectangle x = [{}, {}], y = [{}, {}], {} x {} cells", num(r.x[0]), num(r.x[1]), num(r.y[0]), num(r.y[1]), r.n[0], r.n[1])
-        }
+    let spec = s.mesh.get_ref();
+    let source = match (&spec.file, &spec.rectangle) {
+        _ if p.given_mesh.is_some() => "given as arrays".to_string(),
+        (Some(f), _) => format!("gmsh file {}", quote(f.get_ref())),
+        (None, Some(r)) => format!("rectangle x = [{}, {}], y = [{}, {}], {} x {} cells", num(r.x[0]), num(r.x[1]), num(r.y[0]), num(r.y[1]), r.n[0], r.n[1]),
+        (None, None) => "none".to_string(),
     };
     let _ = writeln!(o, "mesh: {source}: {} nodes, {} elements", mesh.mesh.num_nodes(), mesh.mesh.num_cells());
     if let Some(split) = &mesh.split {

@@ -21,11 +21,34 @@ static FLAGS: OnceLock<Option<Flags>> = OnceLock::new();
 /// Install the handlers (once per process; later calls do nothing) and return the flag they set
 /// (None if they could not be installed: the signals then end the program as by default).
 pub fn install() -> Option<Arc<AtomicBool>> {
+    init(&[SIGINT, SIGTERM], true)
+}
+
+/// For a program with a SIGINT handler of its own (Python's, which raises KeyboardInterrupt): a
+/// handler for SIGINT alone, which sets the flag and then calls the program's handler
+/// (signal-hook chains to the handler it replaced), with no exit at a second signal, SIGTERM left
+/// as it was. The flag stays set until [`clear`]: clear it before each solve. Once per process,
+/// like [`install`] (whichever comes first decides).
+pub fn install_chained() -> Option<Arc<AtomicBool>> {
+    init(&[SIGINT], false)
+}
+
+/// Forget a signal received before (see [`install_chained`]).
+pub fn clear() {
+    if let Some(Some(flags)) = FLAGS.get() {
+        flags.any.store(false, Ordering::Relaxed);
+        flags.which.store(0, Ordering::Relaxed);
+    }
+}
+
+fn init(signals: &[i32], exit_on_second: bool) -> Option<Arc<AtomicBool>> {
     let flags = FLAGS.get_or_init(|| {
         let flags = Flags { any: Arc::new(AtomicBool::new(false)), which: Arc::new(AtomicUsize::new(0)) };
-        for sig in [SIGINT, SIGTERM] {
+        for &sig in signals {
             // the second signal, with the flag already set, exits at once (status 128 + sig)
-            signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, flags.any.clone()).ok()?;
+            if exit_on_second {
+                signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, flags.any.clone()).ok()?;
+            }
             signal_hook::flag::register_usize(sig, flags.which.clone(), sig as usize).ok()?;
             signal_hook::flag::register(sig, flags.any.clone()).ok()?;
         }

@@ -13,7 +13,8 @@
 //! * [`out_dir`]: a run owns its output folder (removes the previous run's files, only those),
 //!   locked by [`folder_lock`] against a second run; [`regular`] refuses FIFOs and the like there;
 //! * [`solve`]: Newton-Raphson along the targets with a progress bar, writing every step;
-//! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step;
+//! * [`output`]: the .vtu fields, summary.json entries and contact CSV of a step ([`kept`]: the
+//!   same kept in memory for the Python package);
 //! * [`refine`]: `stamp run --refine`, the run on refined meshes, with [`richardson`] and
 //!   [`refine_report`] (the estimates in the table, history.csv and summary.json);
 //! * [`plot`]: PNG/SVG line plots (contact pressure here, the paper's Figure 4 in the CLI).
@@ -26,6 +27,7 @@ pub mod folder_lock;
 pub mod check;
 pub mod history;
 pub mod interrupt;
+pub mod kept;
 pub mod memory;
 pub mod mesh;
 pub mod out_dir;

@@ -36,7 +36,10 @@ impl MeshData {
     /// Load the mesh the problem names.
     pub fn load(p: &Problem) -> Result<MeshData> {
         let spec = p.spec.mesh.get_ref();
-        if let Some(file) = &spec.file {
+        if let Some(g) = &p.given_mesh {
+            // gmsh tags are no help with arrays: nodes are named by their coordinates
+            Ok(MeshData { node_tags: None, cell_tags: None, ..Self::of_gmsh(g.as_ref().clone()) })
+        } else if let Some(file) = &spec.file {
             Self::read(p, file, "mesh.file")
         } else {
             let r = spec.rectangle.as_ref().expect("checked: file or rectangle");
@@ -74,9 +77,14 @@ impl MeshData {
             StampError::Input { file, message } => StampError::Input { file, message: format!("{message} (read as {key} of {})", stamp::show_path(&p.path)) },
             e => e,
         })?;
+        Ok(Self::of_gmsh(g))
+    }
+
+    /// A mesh read by the gmsh reader (or given as arrays) with its groups.
+    fn of_gmsh(g: stamp::io::GmshMesh) -> MeshData {
         let surfaces = g.mesh.cell_groups.clone();
         let split = g.split_summary();
-        Ok(MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh, split })
+        MeshData { points: g.point_groups, curves: g.curve_groups, surfaces, node_tags: Some(g.node_tags), cell_tags: Some(g.cell_tags), mesh: g.mesh, split }
     }
 
     /// The built-in rectangle `r` with nx x ny cells and its named groups.

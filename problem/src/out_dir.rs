@@ -152,6 +152,23 @@ impl RunFolder {
     }
 }
 
+/// Copy the files of a finished run (`files`, as [`super::RunOutcome::files`] lists them) into
+/// `dir`, claimed as a run would claim it: the previous run's files there are removed first and
+/// the manifest then lists these. Each file appears whole or not at all. Returns the new paths.
+pub fn copy_run(files: &[PathBuf], dir: &Path) -> Result<Vec<PathBuf>> {
+    let folder = RunFolder::claim(dir)?;
+    let mut copied = Vec::with_capacity(files.len());
+    for from in files {
+        let Some(name) = from.file_name() else { continue };
+        let bytes = std::fs::read(from).map_err(|e| StampError::io(from, e))?;
+        let to = dir.join(name);
+        stamp::io::write_atomically(&to, |w| w.write_all(&bytes))?;
+        copied.push(to);
+    }
+    folder.finish()?;
+    Ok(copied)
+}
+
 /// Removes the files the previous run wrote in `dir` (see the module notes; `legacy`: also a
 /// folder written before manifests existed) and returns their names.
 fn remove_previous_outputs(dir: &Path, legacy: bool) -> Result<Vec<String>> {

@@ -131,6 +131,13 @@ impl Layout {
     pub fn mid_displacement(&self, u: &[f64], n: usize) -> [f64; 3] {
         [0, 1, 2].map(|c| self.mid_terms(n, c).map(|(d, w)| w * u[d]).sum())
     }
+    /// The displacements of every surface at node `n`, from the bottom face (zeta = -1) up to the
+    /// top face (zeta = 1).
+    pub fn surface_displacements(&self, u: &[f64], n: usize) -> Vec<[f64; 3]> {
+        let mut order: Vec<usize> = (0..self.surfaces).collect();
+        order.sort_by(|&a, &b| self.zetas[a].total_cmp(&self.zetas[b]));
+        order.iter().map(|&s| [0, 1, 2].map(|c| u[n * self.dofs_per_node + 3 * s + c])).collect()
+    }
     /// zeta in [-1, 1] of the surface that holds component `c` (0 .. dofs per node) of a node.
     pub fn zeta_of_component(&self, c: usize) -> f64 {
         self.zetas[c / 3]
@@ -207,5 +214,9 @@ mod tests {
         let u: Vec<f64> = (0..12).map(|d| [-1.0, 1.0, -1.0 / 3.0, 1.0 / 3.0][d / 3] * 2.0 + 5.0).collect();
         assert!((four.mid_displacement(&u, 0)[1] - 5.0).abs() < 1e-14);
         assert!((four.zeta_of_component(7) + 1.0 / 3.0).abs() < 1e-15);
+        // bottom, the two inner surfaces, top: the unknowns' zeta order -1, 1, -1/3, 1/3 sorted
+        let by_surface: Vec<f64> = four.surface_displacements(&u, 0).iter().map(|d| d[0]).collect();
+        assert_eq!(by_surface, vec![3.0, 5.0 - 2.0 / 3.0, 5.0 + 2.0 / 3.0, 7.0]);
+        assert_eq!(two.surface_displacements(&(0..12).map(f64::from).collect::<Vec<_>>(), 1), vec![[6.0, 7.0, 8.0], [9.0, 10.0, 11.0]]);
     }
 }

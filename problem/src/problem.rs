@@ -825,7 +825,16 @@ fn toml_message(source: &str, e: &toml::de::Error) -> String {
         ),
         None => what,
     };
-    let what = match key_at(source, line, col) {
+    // an unknown key: toml points at the key itself, which the message names; its table is named
+    // before it ("punch[0]: unknown field `radios`")
+    let unknown_key = || {
+        let text = source.lines().nth(line.checked_sub(1)?)?;
+        let eq = text.chars().skip(col.saturating_sub(1)).position(|c| c == '=')?;
+        let key = key_at(source, line, col + eq + 1)?;
+        key.rsplit_once('.').map(|(table, _)| table.to_string())
+    };
+    let key = if what.starts_with("unknown field") { unknown_key() } else { key_at(source, line, col) };
+    let what = match key {
         // our own checks may name the key already ("mesh.rectangle.n: ...")
         Some(key) if !what.starts_with(&key) => format!("{}: {what}", quote(&key)),
         _ => what,
@@ -918,6 +927,9 @@ pub struct Problem {
     pub path: PathBuf,
     pub source: String,
     pub spec: ProblemFile,
+    /// A mesh given in memory (the Python package's arrays, [`stamp::io::mesh_from_arrays`]) in
+    /// place of `[mesh] file` or `rectangle`.
+    pub given_mesh: Option<std::sync::Arc<stamp::io::GmshMesh>>,
 }
 
 impl Problem {
@@ -949,8 +961,22 @@ impl Problem {
         Problem::parse(path, source)
     }
 
+    /// The problem of a table built in memory (the Python package's dict), with the same schema,
+    /// checks and messages as a file: the table is written as TOML (the text errors point into,
+    /// [`Problem::source`]) and parsed as a file named `path` would be, relative paths starting
+    /// in the folder of `path`. `mesh`, if given, takes the place of `[mesh] file` or `rectangle`
+    /// (the table's `mesh` then has neither).
+    pub fn from_table(path: &Path, table: toml::Table, mesh: Option<stamp::io::GmshMesh>) -> Result<Problem> {
+        let source = toml::to_string(&table).map_err(|e| StampError::Input { file: path.display().to_string(), message: format!("cannot be written as TOML: {e}") })?;
+        Problem::parse_with_mesh(path, source, mesh.map(std::sync::Arc::new))
+    }
+
     /// Parse problem text (`path` names it in errors and anchors relative paths).
     pub fn parse(path: &Path, source: String) -> Result<Problem> {
+        Problem::parse_with_mesh(path, source, None)
+    }
+
+    fn parse_with_mesh(path: &Path, source: String, given_mesh: Option<std::sync::Arc<stamp::io::GmshMesh>>) -> Result<Problem> {
         if source.trim_start().starts_with("$MeshFormat") {
             return Err(StampError::Input {
                 file: path.display().to_string(),
@@ -958,7 +984,7 @@ impl Problem {
             });
         }
         let spec: ProblemFile = toml::from_str(&source).map_err(|e| StampError::Input { file: path.display().to_string(), message: toml_message(&source, &e) })?;
-        let p = Problem { path: path.to_path_buf(), source, spec };
+        let p = Problem { path: path.to_path_buf(), source, spec, given_mesh };
         p.check()?;
         Ok(p)
     }
@@ -994,6 +1020,19 @@ impl Problem {
     fn check(&self) -> Result<()> {
         let s = &self.spec;
         let mesh = s.mesh.get_ref();
+        let coarse = s.solver.predictor.as_ref().filter(|k| *k.get_ref() == Predictor::Coarse);
+        if self.given_mesh.is_some() {
+            if mesh.file.is_some() || mesh.rectangle.is_some() {
+                return Err(self.error_at(s.mesh.span(), "mesh", "give the mesh as arrays (`nodes`, `cells`) or as `file` or `rectangle`, not both"));
+            }
+            if let Some(f) = &mesh.coarse_file {
+                return Err(self.error_at(f.span(), "mesh.coarse_file", "belongs to a gmsh `file`, not to a mesh given as arrays"));
+            }
+            if let Some(k) = coarse {
+                return Err(self.error_at(k.span(), "solver.predictor", "\"coarse\" needs a coarse mesh of the same plate: give the mesh as `rectangle`, or as a gmsh `file` with `coarse_file`"));
+            }
+            return self.check_rest();
+        }
         if mesh.file.is_some() == mesh.rectangle.is_some() {
             return Err(self.error_at(s.mesh.span(), "mesh", "give exactly one of `file` (a gmsh .msh) and `rectangle`"));
         }
@@ -1005,7 +1044,6 @@ impl Problem {
                 return Err(self.error_at(s.mesh.span(), "mesh.rectangle.n", format!("needs at least one cell each way, got {:?}", r.n)));
             }
         }
-        let coarse = s.solver.predictor.as_ref().filter(|k| *k.get_ref() == Predictor::Coarse);
         match (&mesh.rectangle, &mesh.coarse_file, coarse) {
             (Some(_), Some(f), _) => {
                 return Err(self.error_at(f.span(), "mesh.coarse_file", "belongs to a gmsh `file`: with `rectangle`, predictor = \"coarse\" halves its n"));
@@ -1025,6 +1063,12 @@ impl Problem {
             }
             _ => {}
         }
+        self.check_rest()
+    }
+
+    /// The checks after the mesh's.
+    fn check_rest(&self) -> Result<()> {
+        let s = &self.spec;
         let plate = s.plate.get_ref();
         match (plate.thickness, plate.delta_minus, plate.delta_plus) {
             (Some(_), None, None) => {}
@@ -1247,5 +1291,48 @@ impl Problem {
     /// The folder of the problem file (relative paths start there).
     pub fn dir(&self) -> PathBuf {
         self.path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p }).unwrap_or(Path::new(".")).to_path_buf()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = "[mesh]\nrectangle = { x = [0.0, 1.0], y = [0.0, 1.0], n = [2, 2] }\n\n[plate]\nthickness = 0.1\nE = 1.0\nnu = 0.3\n";
+
+    fn table(text: &str) -> toml::Table {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn a_table_is_read_as_its_file_is() {
+        let file = Problem::parse(Path::new("p.toml"), TEXT.into()).unwrap();
+        let built = Problem::from_table(Path::new("p.toml"), table(TEXT), None).unwrap();
+        assert_eq!(format!("{:?}", built.spec.plate.get_ref()), format!("{:?}", file.spec.plate.get_ref()));
+        assert_eq!(format!("{:?}", built.spec.mesh.get_ref().rectangle), format!("{:?}", file.spec.mesh.get_ref().rectangle));
+        // the same message, but for the line, which is the written table's
+        let bad = TEXT.replace("nu = 0.3", "nu = 0.7");
+        let from_file = Problem::parse(Path::new("p.toml"), bad.clone()).unwrap_err().to_string();
+        let from_table = Problem::from_table(Path::new("p.toml"), table(&bad), None).unwrap_err().to_string();
+        let what = |m: &str| m.split_once("plate.nu: ").map(|(_, w)| w.lines().next().unwrap().to_string()).unwrap();
+        assert_eq!(what(&from_table), what(&from_file));
+        assert_eq!(what(&from_file), "expected Poisson's ratio in (-1, 0.5), got 0.7");
+    }
+
+    #[test]
+    fn a_given_mesh_takes_the_place_of_file_and_rectangle() {
+        let nodes = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let mesh = || Some(stamp::io::mesh_from_arrays(Path::new("mesh"), &nodes, &[vec![0, 1, 2, 3]], &[]).unwrap());
+        let given = TEXT.replace("rectangle = { x = [0.0, 1.0], y = [0.0, 1.0], n = [2, 2] }\n", "");
+        let p = Problem::from_table(Path::new("p"), table(&given), mesh()).unwrap();
+        assert_eq!(p.given_mesh.as_ref().unwrap().mesh.num_cells(), 1);
+        let both = Problem::from_table(Path::new("p"), table(TEXT), mesh()).unwrap_err().to_string();
+        assert!(both.contains("mesh: give the mesh as arrays (`nodes`, `cells`) or as `file` or `rectangle`, not both"), "{both}");
+        let coarse = format!("{given}\n[solver]\npredictor = \"coarse\"\n");
+        let e = Problem::from_table(Path::new("p"), table(&coarse), mesh()).unwrap_err().to_string();
+        assert!(e.contains("solver.predictor: \"coarse\" needs a coarse mesh"), "{e}");
+        // without the mesh the table is a file without a mesh
+        let e = Problem::from_table(Path::new("p"), table(&given), None).unwrap_err().to_string();
+        assert!(e.contains("give exactly one of `file` (a gmsh .msh) and `rectangle`"), "{e}");
     }
 }

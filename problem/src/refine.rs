@@ -115,7 +115,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
 
     let running = refinement("solving the problem's mesh".into(), &meshes);
     let mut previous_mesh = setup.mesh.mesh.clone();
-    let opts = SolveOptions { quiet, no_table: true, targets: None, refinement: Some(running), caller_finishes: true, record_states: true, previous: None };
+    let opts = SolveOptions { quiet, no_table: true, targets: None, refinement: Some(running), caller_finishes: true, record_states: true, previous: None, ..Default::default() };
     let coarse = solve_and_write(&p, setup, &out_dir, &opts);
     for w in super::check::after_the_run(&p, &out_dir.join("summary.json")) {
         eprintln!("warning: {w}");
@@ -148,7 +148,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         let previous = PreviousLevel { mesh: std::mem::replace(&mut previous_mesh, mesh.mesh.clone()), states: previous_states.clone() };
         let fine = build_on(&p, mesh).and_then(|setup| {
             let note = json!({ "level": level, "note": format!("the problem's mesh refined {}, driven through the load factors of ../summary.json, every step started from the solution on the mesh before", times(level)) });
-            let opts = SolveOptions { quiet, no_table: true, targets: Some(load_factors.clone()), refinement: Some(note), caller_finishes: false, record_states: level < levels, previous: Some(previous) };
+            let opts = SolveOptions { quiet, no_table: true, targets: Some(load_factors.clone()), refinement: Some(note), caller_finishes: false, record_states: level < levels, previous: Some(previous), ..Default::default() };
             solve_and_write(&p, setup, &dir, &opts)
         });
         match fine {

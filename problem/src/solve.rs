@@ -32,6 +32,8 @@ pub struct RunOutcome {
     /// The converged states (load factor, unknowns) of every step, with
     /// [`SolveOptions::record_states`] (empty otherwise).
     pub states: Vec<(f64, Vec<f64>)>,
+    /// The mesh and the written steps' results, with [`SolveOptions::keep`].
+    pub kept: Option<super::kept::Kept>,
 }
 
 /// How [`solve_and_write`] runs beyond the problem file.
@@ -55,6 +57,12 @@ pub struct SolveOptions {
     /// the secant predictor; it takes precedence over `[solver] predictor = "coarse"`, whose
     /// coarse setup is then not solved.
     pub previous: Option<super::coarse::PreviousLevel>,
+    /// Keep the mesh and every written step's results in [`RunOutcome::kept`].
+    pub keep: bool,
+    /// The flag that stops the solve, set by the caller's own handler
+    /// ([`super::interrupt::install_chained`]); None: the program's handlers for SIGINT and
+    /// SIGTERM are installed ([`super::interrupt::install`]).
+    pub interrupt: Option<Arc<std::sync::atomic::AtomicBool>>,
 }
 
 #[derive(Serialize)]
@@ -283,7 +291,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     super::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
     // from here on Ctrl-C and SIGTERM abandon the step in progress (see interrupt.rs): a signal
     // that comes before the solve ends it at its first iteration
-    let interrupt = super::interrupt::install();
+    let interrupt = match &opts.interrupt {
+        Some(flag) => Some(flag.clone()),
+        None => super::interrupt::install(),
+    };
     // removes the previous run's files; records this run's when dropped (see out_dir.rs)
     let _folder = super::out_dir::RunFolder::claim(out_dir)?;
     let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
@@ -422,6 +433,13 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let mut surface_error: Option<StampError> = None;
     let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
+    let mut kept = opts.keep.then(|| super::kept::Kept {
+        nodes: mesh.mesh.coords.clone(),
+        cells: mesh.mesh.cells.clone(),
+        surfaces: model.element.surfaces(),
+        punches: punch_names.clone(),
+        steps: Vec::new(),
+    });
     // the state before each step, for the checks after it (super::psi_checks)
     let mut u_prev = u.clone();
     let layout = Layout::of(&model.element);
@@ -514,6 +532,9 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
                 abort_note.prepare(&summary_path, aborted(&summary));
             })
         });
+        if let Some(kept) = kept.as_mut().filter(|_| listed) {
+            kept.steps.push(super::kept::KeptStep::new(&data, u, &layout, mesh.mesh.num_nodes()));
+        }
         match step_result {
             Ok(()) => {
                 files.append(&mut written);
@@ -600,6 +621,6 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let converged_steps = summary.steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).count();
     match failure {
         Some(e) => Err(e),
-        None => Ok(RunOutcome { out_dir: out_dir.to_path_buf(), summary: summary_path, converged_steps, files, history, states }),
+        None => Ok(RunOutcome { out_dir: out_dir.to_path_buf(), summary: summary_path, converged_steps, files, history, states, kept }),
     }
 }

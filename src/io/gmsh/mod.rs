@@ -11,8 +11,11 @@
 //! The plate lies in the x1-x2 plane (every z must be 0). A mesh whose cells are all clockwise
 //! (surface normal along -z) is reoriented; a mixture of orientations is an error.
 
+mod arrays;
 mod elements;
 mod sections;
+
+pub use arrays::{mesh_from_arrays, ArrayGroup, GroupItems};
 
 use crate::error::{Result, StampError};
 use crate::mesh::{quad_signed_area, QuadMesh};

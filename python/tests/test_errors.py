@@ -1,0 +1,112 @@
+"""Bad input raises stamp.StampError (a ValueError) with the program's message, naming the key."""
+
+import tomllib
+
+import numpy as np
+import pytest
+
+import stamp
+from conftest import MESHES, run_cli
+
+SPHERE = MESHES / "sphere-ss.toml"
+
+
+def table():
+    with open(SPHERE, "rb") as f:
+        return tomllib.load(f)
+
+
+def raised(t, **kw):
+    with pytest.raises(stamp.StampError) as e:
+        stamp.Problem(t, **kw).solve(quiet=True)
+    assert isinstance(e.value, ValueError)
+    return str(e.value)
+
+
+def test_stamp_error_is_a_value_error():
+    assert issubclass(stamp.StampError, ValueError)
+    assert stamp.StampError.__module__ == "stamp"
+
+
+@pytest.mark.parametrize(
+    "old, new, key, what",
+    [
+        ("nu = 0.3", "nu = 0.7", "plate.nu", "expected Poisson's ratio in (-1, 0.5), got 0.7"),
+        ("steps = 5", "steps = 0", "solver.steps", "expected a whole number from 1 to 100000, got 0"),
+        ('group = "top"', 'group = "tpo"', "boundary[3].group", "no group named 'tpo'"),
+        ("radius = 200.0", "radius = 200.0\nradios = 3", "punch[0]: unknown field", "`radios`"),
+    ],
+)
+def test_a_bad_file_gives_the_programs_message_and_its_dict_the_same_with_the_key(tmp_path, old, new, key, what):
+    text = SPHERE.read_text()
+    assert old in text
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace(old, new, 1))
+    status, _, err = run_cli("run", "-q", bad, "--out", tmp_path / "out")
+    assert status == 1
+    with pytest.raises(stamp.StampError) as e:
+        stamp.Problem.from_toml(bad).solve(quiet=True)
+    # exactly what `stamp run` prints after "error: "
+    assert "error: " + str(e.value) + "\n" == err
+    # the dict: the same key and message (its line numbers point into Problem.toml)
+    with open(bad, "rb") as f:
+        t = tomllib.load(f)
+    m = raised(t, name="bad")
+    assert key in m and what in m, m
+    assert key in err and what in err
+
+
+def test_values_that_are_no_toml_name_their_key():
+    t = table()
+    t["plate"]["E"] = None
+    assert raised(t).startswith("plate.E: None is no value")
+    t = table()
+    t["punch"][0]["center"] = [0.0, 0.0, object()]
+    assert "punch[0].center[2]: expected a number" in raised(t)
+    t = table()
+    t["plate"][3] = 1.0
+    assert "plate: keys are strings" in raised(t)
+
+
+@pytest.mark.parametrize(
+    "mesh, message",
+    [
+        ({"nodes": np.zeros((4, 4)), "cells": [[0, 1, 2, 3]]}, "mesh.nodes: expected an (n, 2) array"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 7]]}, "mesh.cells row 0: node index 7 is out of range (mesh.nodes has 4 rows"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0.0, 1.0, 2.0, 3.0]]}, "mesh.cells: expected whole numbers"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, -1]]}, "mesh.cells: negative index -1"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 3, 0]]}, "mesh.cells: expected an (m, 3 or 4) array, got shape (1, 5)"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]]}, "mesh: give both `nodes`"),
+        ({"nodes": [[0, 0, 0], [1, 0, 0], [1, 1, 1], [0, 1, 0]], "cells": [[0, 1, 2, 3]]}, "mesh.nodes row 2: z = 1.0"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, np.nan]], "cells": [[0, 1, 2, 3]]}, "mesh.nodes row 3: coordinates must be finite"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 3]], "groups": {"left": {"edges": [0]}}}, "mesh.groups.left: expected one of"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 3]], "groups": {"p": {"cells": [3]}}}, "mesh.groups.p.cells row 0: cell index 3 is out of range"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 3]], "groups": {"s": {"segments": [0, 1]}}}, "mesh.groups.s.segments: expected an (m, 2) array"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 3]], "rectangle": {"x": [0, 1], "y": [0, 1], "n": [1, 1]}}, "mesh: give the mesh as arrays (`nodes`, `cells`) or as `file` or `rectangle`, not both"),
+        # the mesh checks of the gmsh reader, with the rows
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [2, 1]], "cells": [[0, 1, 2, 3], [1, 2, 5, 4]]}, "inverted"),
+        ({"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 3], [0, 1, 2, 3]]}, "elements 1 and 2 are duplicates"),
+    ],
+)
+def test_bad_mesh_arrays_name_the_array_and_row(mesh, message):
+    t = table()
+    t["mesh"] = mesh
+    m = raised(t)
+    assert message in m, m
+
+
+def test_a_mesh_given_as_arrays_refuses_the_coarse_predictor():
+    t = table()
+    n = 2
+    t["mesh"] = {"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "cells": [[0, 1, 2, 3]]}
+    t["solver"]["predictor"] = "coarse"
+    assert "solver.predictor: \"coarse\" needs a coarse mesh" in raised(t)
+
+
+def test_check_reports_without_solving():
+    summary, warnings = stamp.Problem.from_toml(SPHERE).check()
+    assert "rectangle x = [0, 20]" in summary and isinstance(warnings, list)
+    t = table()
+    t["boundary"][0]["group"] = "nowhere"
+    with pytest.raises(stamp.StampError, match=r"boundary\[0\]\.group: no group named 'nowhere'"):
+        stamp.Problem(t).check()
