@@ -12,8 +12,12 @@ pub mod material;
 pub mod plate;
 pub mod strain;
 pub mod multi_surface;
+pub mod orthotropic;
+pub mod laminate;
 
 pub use follower::{fixed_couple_force, FollowerCouple, FollowerPressure};
 pub use material::{Isotropic, Layer, NormalStress, Section};
 pub use plate::{Face, Kinematics, PlateElements, DOFS_PER_NODE};
+pub use laminate::{FiveSurfaceLaminate, FourSurfaceLaminate, Laminate, LaminatePlate, Ply, ThreeSurfaceLaminate};
+pub use orthotropic::{Orthotropic, PlyMaterial};
 pub use multi_surface::{FiveSurfacePlate, FourSurfacePlate, MultiSurfacePlate, ThreeSurfacePlate};

@@ -44,6 +44,7 @@
 
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section};
+use crate::orthotropic::Stiffness;
 use crate::plate::Kinematics;
 use crate::strain::{add_geometric_stiffness, axpy, triple, Affine, Sample};
 use faer::linalg::matmul::matmul;
@@ -118,17 +119,84 @@ pub fn lagrange(zs: &[f64], z: f64) -> (Vec<f64>, Vec<f64>) {
 
 /// One integration level through the thickness.
 #[derive(Debug, Clone, Copy)]
-struct Level<const N: usize> {
+pub(crate) struct Level<const N: usize> {
     /// L_s(zeta) and dL_s/dx3 = (2 / h) dL_s/dzeta at this level.
     l: [f64; N],
     dl: [f64; N],
     /// x3 - x3m.
-    x3: f64,
+    pub(crate) x3: f64,
     /// Gauss weight times the length it stands for (sums to h).
     weight: f64,
-    /// lambda, mu of the layer.
-    lambda: f64,
-    mu: f64,
+    /// Index of the level's law in the laws the kernel is given (its layer's).
+    law: usize,
+}
+
+impl<const N: usize> Level<N> {
+    /// The N Gauss levels of the layer [bottom, top] for the surfaces at `zs` (zeta in [-1, 1]
+    /// over the thickness [mid - h/2, mid + h/2] they interpolate), measured from x3 = mid.
+    pub(crate) fn of_layer(bottom: f64, top: f64, mid: f64, h: f64, zs: &[f64], law: usize) -> Vec<Level<N>> {
+        let half = 0.5 * (top - bottom);
+        let centre = 0.5 * (top + bottom);
+        gauss_rule(N)
+            .iter()
+            .map(|&(x, w)| {
+                let x3 = centre + half * x;
+                let (l, dl) = lagrange(zs, 2.0 * (x3 - mid) / h);
+                Level { l: std::array::from_fn(|s| l[s]), dl: std::array::from_fn(|s| 2.0 * dl[s] / h), x3: x3 - mid, weight: w * half, law }
+            })
+            .collect()
+    }
+}
+
+/// The 3D elastic law of a level, in the element's local frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Law {
+    /// S = lambda tr(E) I + 2 mu E.
+    Isotropic { lambda: f64, mu: f64 },
+    /// S = C E, Voigt order [11, 22, 33, 23, 13, 12], engineering shear strains.
+    General(Stiffness),
+}
+
+impl Law {
+    /// S = C E.
+    #[inline(always)]
+    pub(crate) fn stress(&self, e: &[f64; NVOIGT]) -> [f64; NVOIGT] {
+        match self {
+            Law::Isotropic { lambda, mu } => stress(*lambda, *mu, e),
+            Law::General(c) => std::array::from_fn(|i| (0..NVOIGT).map(|j| c[i][j] * e[j]).sum()),
+        }
+    }
+
+    /// cb = w C B for the six rows `r` = dE/dV of one point.
+    #[inline(always)]
+    fn apply_rows<const D: usize>(&self, w: f64, r: &[[f64; D]], cb: &mut [[f64; D]]) {
+        match self {
+            Law::Isotropic { lambda, mu } => {
+                let (l, m) = (w * lambda, w * mu);
+                for i in 0..D {
+                    let tr = r[0][i] + r[1][i] + r[2][i];
+                    cb[0][i] = l * tr + 2.0 * m * r[0][i];
+                    cb[1][i] = l * tr + 2.0 * m * r[1][i];
+                    cb[2][i] = l * tr + 2.0 * m * r[2][i];
+                    cb[3][i] = m * r[3][i];
+                    cb[4][i] = m * r[4][i];
+                    cb[5][i] = m * r[5][i];
+                }
+            }
+            Law::General(c) => {
+                for a in 0..NVOIGT {
+                    let row = &mut cb[a];
+                    row.fill(0.0);
+                    for b in 0..NVOIGT {
+                        let f = w * c[a][b];
+                        if f != 0.0 {
+                            axpy(row, f, &r[b]);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The resultants of the section at the element centre, in its local frame: membrane forces
@@ -150,7 +218,13 @@ pub struct MultiSurfaceWorkspace<const P: usize, const D: usize> {
     cb: Vec<[f64; D]>,
     /// Weights of the sample gradients in the residual and of their Hessians in the tangent.
     mu: Vec<f64>,
-    volume_ratio: f64,
+    pub(crate) volume_ratio: f64,
+}
+
+impl<const P: usize, const D: usize> MultiSurfaceWorkspace<P, D> {
+    pub(crate) fn samples(&self) -> &[Sample<P, D>] {
+        &self.samples
+    }
 }
 
 /// The N-surface plate elements of a mesh; P = 4 N (node, surface) pairs and D = 12 N dofs per
@@ -160,6 +234,7 @@ pub struct MultiSurfacePlate<const N: usize, const P: usize, const D: usize> {
     cells: Vec<[usize; 4]>,
     geometry: Vec<ElementGeometry>,
     levels: Vec<Level<N>>,
+    laws: Vec<Law>,
     section: Section,
     kinematics: Kinematics,
 }
@@ -184,24 +259,12 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
         let mid = 0.5 * (section.delta_minus + section.delta_plus);
         let zs = surface_zetas(N);
         let mut levels = Vec::new();
-        for layer in &section.layers {
-            let (lambda, mu) = (layer.material.lame_lambda(), layer.material.shear_modulus());
-            let half = 0.5 * (layer.top - layer.bottom);
-            let centre = 0.5 * (layer.top + layer.bottom);
-            for &(x, w) in gauss_rule(N) {
-                let x3 = centre + half * x;
-                let (l, dl) = lagrange(&zs, 2.0 * (x3 - mid) / h);
-                levels.push(Level {
-                    l: std::array::from_fn(|s| l[s]),
-                    dl: std::array::from_fn(|s| 2.0 * dl[s] / h),
-                    x3: x3 - mid,
-                    weight: w * half,
-                    lambda,
-                    mu,
-                });
-            }
+        let mut laws = Vec::new();
+        for (k, layer) in section.layers.iter().enumerate() {
+            laws.push(Law::Isotropic { lambda: layer.material.lame_lambda(), mu: layer.material.shear_modulus() });
+            levels.extend(Level::<N>::of_layer(layer.bottom, layer.top, mid, h, &zs, k));
         }
-        Ok(MultiSurfacePlate { cells: mesh.cells.clone(), geometry, levels, section, kinematics })
+        Ok(MultiSurfacePlate { cells: mesh.cells.clone(), geometry, levels, laws, section, kinematics })
     }
 
     pub fn section(&self) -> &Section {
@@ -211,132 +274,11 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
         self.kinematics
     }
 
-    /// The in-plane tangent g0 + u_,i at a level: `dn` the shape-function derivatives, `l` the
-    /// through-thickness functions.
-    #[inline(always)]
-    fn tangent(g0: [f64; 2], dn: [f64; 4], l: &[f64; N], v: &[f64]) -> Affine<P> {
-        let mut c = [0.0; P];
-        for a in 0..4 {
-            for s in 0..N {
-                c[N * a + s] = dn[a] * l[s];
-            }
-        }
-        Affine::new([g0[0], g0[1], 0.0], c, v)
-    }
-
-    /// The transverse base vector e3 + u_,3 at a level, `n` the shape functions at the point.
-    #[inline(always)]
-    fn transverse(n: &[f64; 4], dl: &[f64; N], v: &[f64]) -> Affine<P> {
-        let mut c = [0.0; P];
-        for a in 0..4 {
-            for s in 0..N {
-                c[N * a + s] = n[a] * dl[s];
-            }
-        }
-        Affine::new([0.0, 0.0, 1.0], c, v)
-    }
-
-    /// Every displacement-based strain sample of element e at local dofs `v`, and the smallest
-    /// volume ratio det[g1, g2, g3] / det[G1, G2, G3] at the integration points.
-    fn compute_samples(&self, e: usize, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>) {
-        let geo = &self.geometry[e];
-        let full = self.kinematics == Kinematics::Nonlinear;
-        let reference = geo.frame[0][0] * geo.frame[1][1] - geo.frame[0][1] * geo.frame[1][0];
-        let mut volume_ratio = f64::INFINITY;
-        for (q, lv) in self.levels.iter().enumerate() {
-            let s = &mut ws.samples[q * PER_LEVEL..(q + 1) * PER_LEVEL];
-            for g in 0..4 {
-                let dn = geo.dndy[g];
-                let g1 = Self::tangent(geo.frame[0], [dn[0][0], dn[1][0], dn[2][0], dn[3][0]], &lv.l, v);
-                let g2 = Self::tangent(geo.frame[1], [dn[0][1], dn[1][1], dn[2][1], dn[3][1]], &lv.l, v);
-                let g3 = Self::transverse(&geo.n[g], &lv.dl, v);
-                volume_ratio = volume_ratio.min(triple(&g1.g, &g2.g, &g3.g) / reference);
-                s[4 * g].set(full, 0.5, &g1, &g1);
-                s[4 * g + 1].set(full, 0.5, &g2, &g2);
-                s[4 * g + 2].set(full, 1.0, &g1, &g2);
-                s[4 * g + 3].set(full, 0.5, &g3, &g3);
-            }
-            for (t, sp) in geo.tying.iter().enumerate() {
-                let gt = Self::tangent(sp.base, sp.dn, &lv.l, v);
-                let g3 = Self::transverse(&sp.n, &lv.dl, v);
-                s[TYING_SAMPLE + t].set(full, 1.0, &gt, &g3);
-            }
-        }
-        ws.volume_ratio = volume_ratio;
-    }
-
-    /// The (sample within the level, coefficient) terms of strain component `c` (Voigt order) at
-    /// Gauss point `g`: the paper's projections of the membrane strains, the tying interpolation
-    /// of the transverse shear (as in [`crate::plate`]).
-    fn terms(geo: &ElementGeometry, g: usize, c: usize) -> ([(usize, f64); 4], usize) {
-        let mut t = [(0, 0.0); 4];
-        let mut n = 0;
-        let mut push = |s: usize, w: f64| {
-            if w != 0.0 {
-                t[n] = (s, w);
-                n += 1;
-            }
-        };
-        match c {
-            0 | 1 | 5 => {
-                // E11 over its row, E22 over its column, 2E12 over all four Gauss points
-                let (kind, comp) = match c {
-                    0 => (0, 0),
-                    1 => (1, 1),
-                    _ => (2, 2),
-                };
-                for h in 0..4 {
-                    push(4 * h + comp, geo.proj[kind][g][h]);
-                }
-            }
-            2 => {
-                // E33: its mean over the element plus E33_STABILISATION times the rest
-                for h in 0..4 {
-                    let own = if h == g { E33_STABILISATION } else { 0.0 };
-                    push(4 * h + 3, (1.0 - E33_STABILISATION) * geo.proj[2][g][h] + own);
-                }
-            }
-            _ => {
-                // 2E23 (c = 3, local row 1) or 2E13 (c = 4, row 0) from the covariant shear
-                let row = if c == 4 { 0 } else { 1 };
-                let [x1, x2] = GAUSS_POINTS[g];
-                for (a, (tp, xi)) in [(0usize, x2), (2usize, x1)].into_iter().enumerate() {
-                    let w = geo.jit[g][row][a];
-                    push(TYING_SAMPLE + tp, w * 0.5 * (1.0 - xi));
-                    push(TYING_SAMPLE + tp + 1, w * 0.5 * (1.0 + xi));
-                }
-            }
-        }
-        (t, n)
-    }
-
-    /// The strains [E11, E22, E33, 2E23, 2E13, 2E12] at Gauss point g of level q from the samples.
-    fn strain(geo: &ElementGeometry, samples: &[Sample<P, D>], q: usize, g: usize) -> [f64; NVOIGT] {
-        std::array::from_fn(|c| {
-            let (t, n) = Self::terms(geo, g, c);
-            t[..n].iter().map(|&(s, w)| w * samples[q * PER_LEVEL + s].val).sum()
-        })
-    }
-
     /// The resultants at the centre of element `e` at local dofs `v` (the mean over its Gauss
     /// points), for output.
     pub fn resultants(&self, e: usize, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>) -> Resultants {
-        self.compute_samples(e, v, ws);
-        let geo = &self.geometry[e];
         let mut r = Resultants::default();
-        for (q, lv) in self.levels.iter().enumerate() {
-            for g in 0..4 {
-                let s = stress(lv.lambda, lv.mu, &Self::strain(geo, &ws.samples, q, g));
-                let w = 0.25 * lv.weight;
-                for (k, c) in [0, 1, 5].into_iter().enumerate() {
-                    r.n[k] += w * s[c];
-                    r.m[k] += w * s[c] * lv.x3;
-                }
-                r.q[0] += w * s[4];
-                r.q[1] += w * s[3];
-                r.t33 += w * s[2];
-            }
-        }
+        resultants_of(&self.geometry[e], &self.levels, &self.laws, self.kinematics, v, ws, &mut r);
         r
     }
 
@@ -344,8 +286,148 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
     /// element `e` at local dofs `v` (1 in the reference state and under any rigid motion; <= 0 once
     /// the element turned inside out).
     pub fn smallest_volume_ratio(&self, e: usize, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>) -> f64 {
-        self.compute_samples(e, v, ws);
+        compute_samples(&self.geometry[e], &self.levels, self.kinematics, v, ws);
         ws.volume_ratio
+    }
+}
+
+/// The in-plane tangent g0 + u_,i at a level: `dn` the shape-function derivatives, `l` the
+/// through-thickness functions.
+#[inline(always)]
+fn tangent<const N: usize, const P: usize>(g0: [f64; 2], dn: [f64; 4], l: &[f64; N], v: &[f64]) -> Affine<P> {
+    let mut c = [0.0; P];
+    for a in 0..4 {
+        for s in 0..N {
+            c[N * a + s] = dn[a] * l[s];
+        }
+    }
+    Affine::new([g0[0], g0[1], 0.0], c, v)
+}
+
+/// The transverse base vector e3 + u_,3 at a level, `n` the shape functions at the point.
+#[inline(always)]
+fn transverse<const N: usize, const P: usize>(n: &[f64; 4], dl: &[f64; N], v: &[f64]) -> Affine<P> {
+    let mut c = [0.0; P];
+    for a in 0..4 {
+        for s in 0..N {
+            c[N * a + s] = n[a] * dl[s];
+        }
+    }
+    Affine::new([0.0, 0.0, 1.0], c, v)
+}
+
+/// Every displacement-based strain sample of an element of geometry `geo` at local dofs `v` at
+/// the `levels`, and the smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] at the
+/// integration points.
+pub(crate) fn compute_samples<const N: usize, const P: usize, const D: usize>(
+    geo: &ElementGeometry,
+    levels: &[Level<N>],
+    kinematics: Kinematics,
+    v: &[f64],
+    ws: &mut MultiSurfaceWorkspace<P, D>,
+) {
+    let full = kinematics == Kinematics::Nonlinear;
+    let reference = geo.frame[0][0] * geo.frame[1][1] - geo.frame[0][1] * geo.frame[1][0];
+    let mut volume_ratio = f64::INFINITY;
+    for (q, lv) in levels.iter().enumerate() {
+        let s = &mut ws.samples[q * PER_LEVEL..(q + 1) * PER_LEVEL];
+        for g in 0..4 {
+            let dn = geo.dndy[g];
+            let g1 = tangent::<N, P>(geo.frame[0], [dn[0][0], dn[1][0], dn[2][0], dn[3][0]], &lv.l, v);
+            let g2 = tangent::<N, P>(geo.frame[1], [dn[0][1], dn[1][1], dn[2][1], dn[3][1]], &lv.l, v);
+            let g3 = transverse::<N, P>(&geo.n[g], &lv.dl, v);
+            volume_ratio = volume_ratio.min(triple(&g1.g, &g2.g, &g3.g) / reference);
+            s[4 * g].set(full, 0.5, &g1, &g1);
+            s[4 * g + 1].set(full, 0.5, &g2, &g2);
+            s[4 * g + 2].set(full, 1.0, &g1, &g2);
+            s[4 * g + 3].set(full, 0.5, &g3, &g3);
+        }
+        for (t, sp) in geo.tying.iter().enumerate() {
+            let gt = tangent::<N, P>(sp.base, sp.dn, &lv.l, v);
+            let g3 = transverse::<N, P>(&sp.n, &lv.dl, v);
+            s[TYING_SAMPLE + t].set(full, 1.0, &gt, &g3);
+        }
+    }
+    ws.volume_ratio = volume_ratio;
+}
+
+/// The (sample within the level, coefficient) terms of strain component `c` (Voigt order) at
+/// Gauss point `g`: the paper's projections of the membrane strains, the tying interpolation
+/// of the transverse shear (as in [`crate::plate`]).
+fn terms(geo: &ElementGeometry, g: usize, c: usize) -> ([(usize, f64); 4], usize) {
+    let mut t = [(0, 0.0); 4];
+    let mut n = 0;
+    let mut push = |s: usize, w: f64| {
+        if w != 0.0 {
+            t[n] = (s, w);
+            n += 1;
+        }
+    };
+    match c {
+        0 | 1 | 5 => {
+            // E11 over its row, E22 over its column, 2E12 over all four Gauss points
+            let (kind, comp) = match c {
+                0 => (0, 0),
+                1 => (1, 1),
+                _ => (2, 2),
+            };
+            for h in 0..4 {
+                push(4 * h + comp, geo.proj[kind][g][h]);
+            }
+        }
+        2 => {
+            // E33: its mean over the element plus E33_STABILISATION times the rest
+            for h in 0..4 {
+                let own = if h == g { E33_STABILISATION } else { 0.0 };
+                push(4 * h + 3, (1.0 - E33_STABILISATION) * geo.proj[2][g][h] + own);
+            }
+        }
+        _ => {
+            // 2E23 (c = 3, local row 1) or 2E13 (c = 4, row 0) from the covariant shear
+            let row = if c == 4 { 0 } else { 1 };
+            let [x1, x2] = GAUSS_POINTS[g];
+            for (a, (tp, xi)) in [(0usize, x2), (2usize, x1)].into_iter().enumerate() {
+                let w = geo.jit[g][row][a];
+                push(TYING_SAMPLE + tp, w * 0.5 * (1.0 - xi));
+                push(TYING_SAMPLE + tp + 1, w * 0.5 * (1.0 + xi));
+            }
+        }
+    }
+    (t, n)
+}
+
+/// The strains [E11, E22, E33, 2E23, 2E13, 2E12] at Gauss point g of level q from the samples.
+pub(crate) fn strain<const P: usize, const D: usize>(geo: &ElementGeometry, samples: &[Sample<P, D>], q: usize, g: usize) -> [f64; NVOIGT] {
+    std::array::from_fn(|c| {
+        let (t, n) = terms(geo, g, c);
+        t[..n].iter().map(|&(s, w)| w * samples[q * PER_LEVEL + s].val).sum()
+    })
+}
+
+/// Adds the resultants of the `levels` (membrane forces, moments about the levels' x3 = 0, shear
+/// forces, T33) at the element's centre, the mean over its Gauss points, to `r`.
+pub(crate) fn resultants_of<const N: usize, const P: usize, const D: usize>(
+    geo: &ElementGeometry,
+    levels: &[Level<N>],
+    laws: &[Law],
+    kinematics: Kinematics,
+    v: &[f64],
+    ws: &mut MultiSurfaceWorkspace<P, D>,
+    r: &mut Resultants,
+) {
+    compute_samples(geo, levels, kinematics, v, ws);
+    for (q, lv) in levels.iter().enumerate() {
+        for g in 0..4 {
+            let s = laws[lv.law].stress(&strain(geo, &ws.samples, q, g));
+            let w = 0.25 * lv.weight;
+            for (k, c) in [0, 1, 5].into_iter().enumerate() {
+                r.n[k] += w * s[c];
+                r.m[k] += w * s[c] * lv.x3;
+            }
+            r.q[0] += w * s[4];
+            r.q[1] += w * s[3];
+            r.t33 += w * s[2];
+        }
     }
 }
 
@@ -357,6 +439,106 @@ fn stress(l: f64, m: f64, e: &[f64; NVOIGT]) -> [f64; NVOIGT] {
     [l * tr + 2.0 * m * e[0], l * tr + 2.0 * m * e[1], l * tr + 2.0 * m * e[2], m * e[3], m * e[4], m * e[5]]
 }
 
+/// A workspace for `levels` integration levels.
+pub(crate) fn workspace<const P: usize, const D: usize>(levels: usize) -> MultiSurfaceWorkspace<P, D> {
+    MultiSurfaceWorkspace {
+        samples: vec![Sample::default(); levels * PER_LEVEL],
+        b: vec![[0.0; D]; levels * 4 * NVOIGT],
+        cb: vec![[0.0; D]; levels * 4 * NVOIGT],
+        mu: vec![0.0; levels * PER_LEVEL],
+        volume_ratio: 1.0,
+    }
+}
+
+/// The element of geometry `geo` over the `levels` at local dofs `v`: adds its internal force to
+/// `residual` (D), its energy to `energy` and, `with_tangent`, its tangent to `tangent` (D x D,
+/// row-major). Leaves the smallest volume ratio in `ws.volume_ratio`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn evaluate_levels<const N: usize, const P: usize, const D: usize>(
+    geo: &ElementGeometry,
+    levels: &[Level<N>],
+    laws: &[Law],
+    kinematics: Kinematics,
+    v: &[f64],
+    ws: &mut MultiSurfaceWorkspace<P, D>,
+    residual_out: &mut [f64],
+    tangent_out: &mut [f64],
+    energy: &mut f64,
+    with_tangent: bool,
+) {
+    compute_samples(geo, levels, kinematics, v, ws);
+    let MultiSurfaceWorkspace { samples, b, cb, mu, .. } = ws;
+    mu.fill(0.0);
+    for (q, lv) in levels.iter().enumerate() {
+        let law = &laws[lv.law];
+        for g in 0..4 {
+            let w = geo.wdet[g] * lv.weight;
+            let strain = strain(geo, samples, q, g);
+            let s = law.stress(&strain);
+            *energy += 0.5 * w * (0..NVOIGT).map(|c| strain[c] * s[c]).sum::<f64>();
+            let rows = (q * 4 + g) * NVOIGT;
+            for c in 0..NVOIGT {
+                let (t, n) = terms(geo, g, c);
+                let mut row = [0.0; D];
+                for &(smp, coef) in &t[..n] {
+                    let k = q * PER_LEVEL + smp;
+                    mu[k] += w * s[c] * coef;
+                    if with_tangent {
+                        axpy(&mut row, coef, &samples[k].grad);
+                    }
+                }
+                b[rows + c] = row;
+            }
+            if with_tangent {
+                // w C B: the law applied to the rows
+                law.apply_rows(w, &b[rows..rows + NVOIGT], &mut cb[rows..rows + NVOIGT]);
+            }
+        }
+    }
+    let mut residual = [0.0; D];
+    for (k, smp) in samples.iter().enumerate() {
+        if mu[k] != 0.0 {
+            axpy(&mut residual, mu[k], &smp.grad);
+        }
+    }
+    for (r, x) in residual_out.iter_mut().zip(residual) {
+        *r += x;
+    }
+    if !with_tangent {
+        return;
+    }
+    // material stiffness: B^T (w C B) over all rows, one D x rows x D product
+    let rows = b.len();
+    let bm = MatRef::from_row_major_slice(b.as_flattened(), rows, D);
+    let cbm = MatRef::from_row_major_slice(cb.as_flattened(), rows, D);
+    let k = MatMut::from_row_major_slice_mut(&mut tangent_out[..D * D], D, D);
+    matmul(k, Accum::Add, bm.transpose(), cbm, 1.0, Par::Seq);
+    clean_upper_vector_state();
+    // geometric stiffness: sum_s mu_s scale_s (a b^T + b a^T) (x) I3
+    if kinematics == Kinematics::Nonlinear {
+        let mut x = [[0.0; P]; P];
+        for (k, smp) in samples.iter().enumerate() {
+            let f = mu[k] * smp.scale;
+            if f == 0.0 {
+                continue;
+            }
+            for p in 0..P {
+                let fa = f * smp.a[p];
+                if fa != 0.0 {
+                    for l in 0..P {
+                        x[p][l] += fa * smp.b[l];
+                    }
+                }
+            }
+        }
+        add_geometric_stiffness(&x, tangent_out);
+    }
+}
+
+/// The message of an element turned inside out.
+pub(crate) fn inside_out(volume_ratio: f64) -> String {
+    format!("it turned inside out (smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] at an integration point: {volume_ratio:.3e})")
+}
 
 impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePlate<N, P, D> {
     type Workspace = MultiSurfaceWorkspace<P, D>;
@@ -374,101 +556,16 @@ impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePla
         &self.cells[e]
     }
     fn new_workspace(&self) -> MultiSurfaceWorkspace<P, D> {
-        let nq = self.levels.len();
-        MultiSurfaceWorkspace {
-            samples: vec![Sample::default(); nq * PER_LEVEL],
-            b: vec![[0.0; D]; nq * 4 * NVOIGT],
-            cb: vec![[0.0; D]; nq * 4 * NVOIGT],
-            mu: vec![0.0; nq * PER_LEVEL],
-            volume_ratio: 1.0,
-        }
+        workspace(self.levels.len())
     }
 
     /// The nonlinear element refuses a state in which it turned inside out (it still computes the
     /// residual and tangent there); the linear theory has no such limit.
     fn evaluate(&self, e: usize, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
-        self.compute_samples(e, v, ws);
+        let LocalSystem { residual, tangent, energy, .. } = out;
+        evaluate_levels(&self.geometry[e], &self.levels, &self.laws, self.kinematics, v, ws, residual, tangent, energy, with_tangent);
         if self.kinematics == Kinematics::Nonlinear && ws.volume_ratio <= 0.0 {
-            out.inadmissible = Some(format!(
-                "it turned inside out (smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] at an integration point: {:.3e})",
-                ws.volume_ratio
-            ));
-        }
-        let geo = &self.geometry[e];
-        let MultiSurfaceWorkspace { samples, b, cb, mu, .. } = ws;
-        mu.fill(0.0);
-        for (q, lv) in self.levels.iter().enumerate() {
-            for g in 0..4 {
-                let w = geo.wdet[g] * lv.weight;
-                let strain = Self::strain(geo, samples, q, g);
-                let s = stress(lv.lambda, lv.mu, &strain);
-                out.energy += 0.5 * w * (0..NVOIGT).map(|c| strain[c] * s[c]).sum::<f64>();
-                let rows = (q * 4 + g) * NVOIGT;
-                for c in 0..NVOIGT {
-                    let (t, n) = Self::terms(geo, g, c);
-                    let mut row = [0.0; D];
-                    for &(smp, coef) in &t[..n] {
-                        let k = q * PER_LEVEL + smp;
-                        mu[k] += w * s[c] * coef;
-                        if with_tangent {
-                            axpy(&mut row, coef, &samples[k].grad);
-                        }
-                    }
-                    b[rows + c] = row;
-                }
-                if with_tangent {
-                    // w C B: the isotropic law applied to the rows
-                    let r = &b[rows..rows + NVOIGT];
-                    let (l, m) = (w * lv.lambda, w * lv.mu);
-                    for i in 0..D {
-                        let tr = r[0][i] + r[1][i] + r[2][i];
-                        cb[rows][i] = l * tr + 2.0 * m * r[0][i];
-                        cb[rows + 1][i] = l * tr + 2.0 * m * r[1][i];
-                        cb[rows + 2][i] = l * tr + 2.0 * m * r[2][i];
-                        cb[rows + 3][i] = m * r[3][i];
-                        cb[rows + 4][i] = m * r[4][i];
-                        cb[rows + 5][i] = m * r[5][i];
-                    }
-                }
-            }
-        }
-        let mut residual = [0.0; D];
-        for (k, smp) in samples.iter().enumerate() {
-            if mu[k] != 0.0 {
-                axpy(&mut residual, mu[k], &smp.grad);
-            }
-        }
-        for (r, x) in out.residual.iter_mut().zip(residual) {
-            *r += x;
-        }
-        if !with_tangent {
-            return;
-        }
-        // material stiffness: B^T (w C B) over all rows, one D x rows x D product
-        let rows = b.len();
-        let bm = MatRef::from_row_major_slice(b.as_flattened(), rows, D);
-        let cbm = MatRef::from_row_major_slice(cb.as_flattened(), rows, D);
-        let k = MatMut::from_row_major_slice_mut(&mut out.tangent[..D * D], D, D);
-        matmul(k, Accum::Add, bm.transpose(), cbm, 1.0, Par::Seq);
-        clean_upper_vector_state();
-        // geometric stiffness: sum_s mu_s scale_s (a b^T + b a^T) (x) I3
-        if self.kinematics == Kinematics::Nonlinear {
-            let mut x = [[0.0; P]; P];
-            for (k, smp) in samples.iter().enumerate() {
-                let f = mu[k] * smp.scale;
-                if f == 0.0 {
-                    continue;
-                }
-                for p in 0..P {
-                    let fa = f * smp.a[p];
-                    if fa != 0.0 {
-                        for l in 0..P {
-                            x[p][l] += fa * smp.b[l];
-                        }
-                    }
-                }
-            }
-            add_geometric_stiffness(&x, &mut out.tangent);
+            out.inadmissible = Some(inside_out(ws.volume_ratio));
         }
     }
 }
