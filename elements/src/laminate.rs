@@ -241,27 +241,23 @@ impl<const N: usize, const P: usize, const D: usize> LaminatePlate<N, P, D> {
         r
     }
 
-    /// The six stresses (second Piola-Kirchhoff, Voigt order [11, 22, 33, 23, 13, 12], in the plate's
-    /// axes x1, x2, x3) of ply `k` at the four Gauss points of element `e` and the ply's N Gauss
-    /// levels, by the 3D law from the element's (assumed) strains: `[level][gauss point]`, with the
-    /// levels' x3.
-    pub fn ply_stresses(&self, e: usize, k: usize, v: &[f64], ws: &mut LaminateWorkspace<P, D>) -> Vec<(f64, [[f64; 6]; 4])> {
+    /// The six stresses (second Piola-Kirchhoff, Voigt order [11, 22, 33, 23, 13, 12]) in the
+    /// plate's axes x1, x2, x3 at height `x3` of ply `k` at the four Gauss points of element `e`,
+    /// by the ply's 3D law from the element's strains there (the assumed strains of the plate: the
+    /// membrane strains projected over the element's rows and columns, the transverse shear tied
+    /// at the edge midpoints); their mean is the value at the element's centre.
+    pub fn stresses_at(&self, e: usize, k: usize, x3: f64, v: &[f64], ws: &mut LaminateWorkspace<P, D>) -> [[f64; 6]; 4] {
         let ply = &self.plies[k];
+        let b = self.laminate.boundaries();
+        let (bottom, top) = (b[k], b[k + 1]);
+        let centre = 0.5 * (bottom + top);
+        let zs: [f64; N] = std::array::from_fn(|s| -1.0 + 2.0 * s as f64 / (N - 1) as f64);
+        let level = Level::<N>::at(x3 - centre, top - bottom, &zs, 0);
         Self::gather(ply, v, &mut ws.v);
         let geo = &self.geometry[e];
-        compute_samples(geo, &ply.levels, self.kinematics, &ws.v, &mut ws.inner);
+        compute_samples(geo, std::slice::from_ref(&level), self.kinematics, &ws.v, &mut ws.inner);
         let law = self.law(e, k);
-        ply.levels
-            .iter()
-            .enumerate()
-            .map(|(q, lv)| {
-                let s = std::array::from_fn(|g| {
-                    let local = law.stress(&strain(geo, ws.inner.samples(), q, g));
-                    crate::orthotropic::rotate_stress(&local, -self.frame_angle[e])
-                });
-                (lv.x3, s)
-            })
-            .collect()
+        std::array::from_fn(|g| crate::orthotropic::rotate_stress(&law.stress(&strain(geo, ws.inner.samples(), 0, g)), -self.frame_angle[e]))
     }
 
     /// The smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] over the integration points of

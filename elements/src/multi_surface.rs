@@ -132,6 +132,13 @@ pub(crate) struct Level<const N: usize> {
 }
 
 impl<const N: usize> Level<N> {
+    /// A level at height `x3` from the middle of a thickness `h` whose surfaces are at `zs`
+    /// (zeta in [-1, 1]), with no weight: for evaluating strains there.
+    pub(crate) fn at(x3: f64, h: f64, zs: &[f64], law: usize) -> Level<N> {
+        let (l, dl) = lagrange(zs, 2.0 * x3 / h);
+        Level { l: std::array::from_fn(|s| l[s]), dl: std::array::from_fn(|s| 2.0 * dl[s] / h), x3, weight: 0.0, law }
+    }
+
     /// The N Gauss levels of the layer [bottom, top] for the surfaces at `zs` (zeta in [-1, 1]
     /// over the thickness [mid - h/2, mid + h/2] they interpolate), measured from x3 = mid.
     pub(crate) fn of_layer(bottom: f64, top: f64, mid: f64, h: f64, zs: &[f64], law: usize) -> Vec<Level<N>> {
