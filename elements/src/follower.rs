@@ -63,8 +63,9 @@ pub struct FollowerPressure {
     cells: Vec<[usize; 4]>,
     /// Reference positions of the cell's face nodes.
     x: Vec<[[f64; 3]; 4]>,
-    /// -s p per cell (the pressure at load factor 1, the face's and the cell orientation's sign).
-    scale: Vec<f64>,
+    /// -s p per cell and Gauss point (the pressure at load factor 1 there, the face's and the cell
+    /// orientation's sign).
+    scale: Vec<[f64; 4]>,
     /// Shape functions and their xi-derivatives at the 2 x 2 Gauss points (weight 1).
     gauss: [([f64; 4], [[f64; 2]; 4]); 4],
     /// Unknowns per node of the plate (see [`Face::dof_in`]).
@@ -75,19 +76,28 @@ impl FollowerPressure {
     /// Pressure `p` (at load factor 1, positive towards the plate) on `face` (at x3 = `z`) of
     /// `cells` of a mesh with nodal `coords`.
     pub fn new(name: impl Into<String>, coords: &[[f64; 2]], cells: &[[usize; 4]], face: Face, z: f64, p: f64) -> Self {
+        Self::varying(name, coords, cells, face, z, &|_, _| p)
+    }
+
+    /// The same with a pressure p(x1, x2) that varies over the face, taken at the reference
+    /// position of each Gauss point (the pressure stays with the material point it acts on).
+    pub fn varying(name: impl Into<String>, coords: &[[f64; 2]], cells: &[[usize; 4]], face: Face, z: f64, p: &dyn Fn(f64, f64) -> f64) -> Self {
         let s_face = match face {
             Face::Top => 1.0,
             Face::Bottom => -1.0,
         };
+        let gauss = GAUSS_POINTS.map(|[s, t]| bilinear(s, t));
         let mut x = Vec::with_capacity(cells.len());
         let mut scale = Vec::with_capacity(cells.len());
         for c in cells {
             let xy = c.map(|n| coords[n]);
             let orient = if quad_signed_area(&xy) >= 0.0 { 1.0 } else { -1.0 };
             x.push(xy.map(|q| [q[0], q[1], z]));
-            scale.push(-s_face * orient * p);
+            scale.push(gauss.map(|(n, _)| {
+                let at = |i: usize| (0..4).map(|a| n[a] * xy[a][i]).sum::<f64>();
+                -s_face * orient * p(at(0), at(1))
+            }));
         }
-        let gauss = GAUSS_POINTS.map(|[s, t]| bilinear(s, t));
         FollowerPressure { name: name.into(), face, cells: cells.to_vec(), x, scale, gauss, dofs_per_node: crate::DOFS_PER_NODE }
     }
     /// The same on a plate with `n` unknowns per node (default: the paper's six).
@@ -103,7 +113,7 @@ impl DeformationDependentLoad for FollowerPressure {
     }
 
     fn add_force_and_stiffness(&self, u: &[f64], force: &mut [f64], mut tangent: Option<&mut dyn FnMut(usize, usize, f64)>) {
-        for ((cell, x0), &scale) in self.cells.iter().zip(&self.x).zip(&self.scale) {
+        for ((cell, x0), scales) in self.cells.iter().zip(&self.x).zip(&self.scale) {
             let mut dof = [[0usize; 3]; 4];
             let mut x = *x0;
             for a in 0..4 {
@@ -114,7 +124,7 @@ impl DeformationDependentLoad for FollowerPressure {
             }
             let mut f = [[0.0; 3]; 4];
             let mut k = [[[[0.0; 3]; 3]; 4]; 4];
-            for (n, dn) in &self.gauss {
+            for ((n, dn), &scale) in self.gauss.iter().zip(scales) {
                 let mut g1 = [0.0; 3];
                 let mut g2 = [0.0; 3];
                 for a in 0..4 {

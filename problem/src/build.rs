@@ -148,7 +148,7 @@ pub fn build(p: &Problem) -> Result<Setup> {
     })?;
     // a gmsh mesh is read first (its size bounded by its file); refuse it before the model is built,
     // and a rectangle (checked for the paper's plate when read) too if the plate has more unknowns
-    let dofs_per_node = super::memory::dofs_per_node(s.plate.get_ref().surfaces);
+    let dofs_per_node = s.plate.get_ref().dofs_per_node();
     let fits = super::memory::check_problem_fits(&stl_dies(p), mesh.mesh.num_nodes() as u64, dofs_per_node);
     match &s.mesh.get_ref().file {
         _ if p.given_mesh.is_some() => fits.map_err(|m| p.error_at(s.mesh.span(), "mesh.nodes", m))?,
@@ -247,22 +247,36 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
 
     // plate
     let ps = s.plate.get_ref();
-    let material = Isotropic::new(ps.young.0, ps.nu.0).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
-    let (dm, dp) = match ps.thickness {
-        Some(h) => (-0.5 * h.0, 0.5 * h.0),
-        None => (ps.delta_minus.unwrap().0, ps.delta_plus.unwrap().0),
-    };
-    let mut section = Section::homogeneous_offset(dm, dp, material).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
-    section.normal_stress = ps.normal_stress;
-    if let Some(k) = ps.shear_factor {
-        section = section.with_shear_factor(k.0).map_err(|e| p.error_at(s.plate.span(), "plate.shear_factor", e))?;
-    }
     let kin = match ps.kinematics {
         KinematicsSpec::Nonlinear => Kinematics::Nonlinear,
         KinematicsSpec::Linear => Kinematics::Linear,
     };
-    let surfaces = ps.surfaces.0;
-    if surfaces > 2 {
+    let laminate = super::laminate_spec::laminate(p)?;
+    // the section: the plate's (homogeneous), or the laminate's faces and a modulus standing for it
+    // (the geometry the loads and punches use; the elements take the laminate itself)
+    let (section, young) = match &laminate {
+        Some((lam, _)) => {
+            let young = super::laminate_spec::reference_modulus(lam);
+            let stand_in = Isotropic::new(young, 0.0).map_err(|e| p.error_at(s.plate.span(), "plate.layers", e))?;
+            (Section::homogeneous(lam.thickness(), stand_in).map_err(|e| p.error_at(s.plate.span(), "plate.layers", e))?, young)
+        }
+        None => {
+            let (young, nu) = (ps.young.expect("checked").0, ps.nu.expect("checked").0);
+            let material = Isotropic::new(young, nu).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
+            let (dm, dp) = match ps.thickness {
+                Some(h) => (-0.5 * h.0, 0.5 * h.0),
+                None => (ps.delta_minus.unwrap().0, ps.delta_plus.unwrap().0),
+            };
+            let mut section = Section::homogeneous_offset(dm, dp, material).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
+            section.normal_stress = ps.normal_stress;
+            if let Some(k) = ps.shear_factor {
+                section = section.with_shear_factor(k.0).map_err(|e| p.error_at(s.plate.span(), "plate.shear_factor", e))?;
+            }
+            (section, young)
+        }
+    };
+    let surfaces = ps.surfaces();
+    if surfaces > 2 && laminate.is_none() {
         let bad = if ps.shear_factor.is_some() { Some("shear_factor") } else if ps.normal_stress != NormalStress::Dropped { Some("normal_stress") } else { None };
         if let Some(key) = bad {
             return Err(p.error_at(
@@ -272,7 +286,11 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
             ));
         }
     }
-    let plate = Plate::new(surfaces, &mesh.mesh, section.clone(), kin).map_err(|e| mesh_error(p, &mesh, e))?;
+    let plate = match laminate {
+        Some((lam, per_layer)) => Plate::layered(per_layer, &mesh.mesh, lam, kin),
+        None => Plate::new(surfaces, &mesh.mesh, section.clone(), kin),
+    }
+    .map_err(|e| mesh_error(p, &mesh, e))?;
     let layout = Layout::of(&plate);
 
     // constraints
@@ -322,25 +340,39 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
             }
             LoadKind::Surface | LoadKind::Pressure => {
                 let cells = mesh.surfaces.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "surface", &mesh))?;
-                if ls.kind == LoadKind::Pressure && ls.follower {
-                    let (f, z) = match face {
-                        LoadFace::Top => (Face::Top, section.delta_plus),
-                        _ => (Face::Bottom, section.delta_minus),
+                let size = model_size(&mesh, &section, None);
+                if ls.kind == LoadKind::Pressure {
+                    let spec = ls.pressure.as_ref().unwrap();
+                    let q = super::pressure::pressure_function(spec.get_ref(), size);
+                    let pkey = format!("load[{i}].pressure");
+                    if ls.follower {
+                        let (f, z) = match face {
+                            LoadFace::Top => (Face::Top, section.delta_plus),
+                            _ => (Face::Bottom, section.delta_minus),
+                        };
+                        // the values at the Gauss points are checked as for a dead load
+                        super::pressure::nodal_forces(p, spec.span(), &pkey, &mesh.mesh, cells, &*q)?;
+                        let quads: Vec<[usize; 4]> = cells.iter().map(|&c| mesh.mesh.cells[c]).collect();
+                        let what = format!("follower pressure on '{}'", stamp::quote(name));
+                        model.add_follower_load(Box::new(
+                            FollowerPressure::varying(what, &mesh.mesh.coords, &quads, f, z, &*q).with_dofs_per_node(layout.dofs_per_node),
+                        ));
+                        continue;
+                    }
+                    let sign = if face == LoadFace::Top { -1.0 } else { 1.0 };
+                    let nodal = match spec.get_ref() {
+                        // int N_a dA times q, as before pressures could vary
+                        super::problem::PressureSpec::Uniform(q) => mesh.nodal_areas_of(cells).into_iter().map(|a| a * q).collect(),
+                        _ => super::pressure::nodal_forces(p, spec.span(), &pkey, &mesh.mesh, cells, &*q)?,
                     };
-                    let quads: Vec<[usize; 4]> = cells.iter().map(|&c| mesh.mesh.cells[c]).collect();
-                    let what = format!("follower pressure on '{}'", stamp::quote(name));
-                    model.add_follower_load(Box::new(
-                        FollowerPressure::new(what, &mesh.mesh.coords, &quads, f, z, ls.pressure.unwrap().0).with_dofs_per_node(layout.dofs_per_node),
-                    ));
+                    for (n, &fz) in nodal.iter().enumerate() {
+                        if fz != 0.0 {
+                            add_force(&mut model, &layout, n, [0.0, 0.0, sign * fz], face)?;
+                        }
+                    }
                     continue;
                 }
-                let f = match ls.kind {
-                    LoadKind::Surface => ls.force.unwrap().0,
-                    _ => {
-                        let q = ls.pressure.unwrap().0;
-                        if face == LoadFace::Top { [0.0, 0.0, -q] } else { [0.0, 0.0, q] }
-                    }
-                };
+                let f = ls.force.unwrap().0;
                 let w = mesh.nodal_areas_of(cells);
                 for (n, &a) in w.iter().enumerate() {
                     if a > 0.0 {
@@ -382,7 +414,6 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
     }
 
     // punches
-    let young = ps.young.0;
     let h = section.thickness();
     let le = mesh.element_size();
     let mut punches = Vec::new();

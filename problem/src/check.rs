@@ -464,9 +464,24 @@ fn load_total(p: &Problem, mesh: &MeshData, i: usize) -> [f64; 3] {
             ls.force.unwrap().0.map(|f| f * a)
         }
         LoadKind::Pressure => {
-            let a = mesh.surfaces.get(name).map(|c| area(c)).unwrap_or(0.0);
-            let q = ls.pressure.unwrap().0;
-            [0.0, 0.0, if ls.face == Some(LoadFace::Top) { -q * a } else { q * a }]
+            let total = match ls.pressure.as_ref().unwrap().get_ref() {
+                super::problem::PressureSpec::Uniform(q) => q * mesh.surfaces.get(name).map(|c| area(c)).unwrap_or(0.0),
+                spec => {
+                    let q = super::pressure::pressure_function(spec, 1.0);
+                    let cells = mesh.surfaces.get(name).cloned().unwrap_or_default();
+                    let mut f = 0.0;
+                    for &c in &cells {
+                        let x = mesh.mesh.cell_coords(c);
+                        for (s, t) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(s, t): (f64, f64)| (s * 0.577_350_269_189_625_8, t * 0.577_350_269_189_625_8)) {
+                            let (n, dn) = stamp::mesh::bilinear(s, t);
+                            let at = |i: usize| (0..4).map(|a| n[a] * x[a][i]).sum::<f64>();
+                            f += q(at(0), at(1)) * stamp::mesh::bilinear_jacobian(&x, &dn).abs();
+                        }
+                    }
+                    f
+                }
+            };
+            [0.0, 0.0, if ls.face == Some(LoadFace::Top) { -total } else { total }]
         }
         // a couple: force pairs without resultant
         LoadKind::Moment => [0.0; 3],
@@ -516,23 +531,40 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
         let _ = writeln!(o, "  cut into 4-node plate elements: {split}");
     }
     let ps = s.plate.get_ref();
-    let _ = writeln!(
-        o,
-        "plate: {}, thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}{}{}",
-        match setup.model.element.surfaces() {
-            2 => "two surfaces (the paper's plate)".to_string(),
-            n => format!("{n} surfaces (displacement of degree {} through the thickness, 3D law)", n - 1),
-        },
-        num(setup.section.thickness()),
-        num(setup.section.delta_minus),
-        num(setup.section.delta_plus),
-        num(ps.young.0),
-        num(ps.nu.0),
-        format!("{:?}", ps.kinematics).to_lowercase(),
-        if ps.plane_strain { ", plane strain" } else { "" },
-        if setup.section.normal_stress == stamp_elements::NormalStress::Mean { ", mean S33 in the in-plane law" } else { "" },
-        if setup.section.shear_factor != 1.0 { format!(", shear factor {}", num(setup.section.shear_factor)) } else { String::new() }
-    );
+    if let Some((lam, per_layer)) = setup.model.element.laminate() {
+        let _ = writeln!(
+            o,
+            "plate: {} layers of {per_layer} surfaces each ({} surfaces, the 3D law of each layer), thickness {} (x3 from {} to {}), {}{}",
+            lam.plies.len(),
+            setup.model.element.surfaces(),
+            num(setup.section.thickness()),
+            num(setup.section.delta_minus),
+            num(setup.section.delta_plus),
+            format!("{:?}", ps.kinematics).to_lowercase(),
+            if ps.plane_strain { ", plane strain" } else { "" },
+        );
+        for line in super::laminate_spec::describe(p, lam, per_layer) {
+            let _ = writeln!(o, "  {line}");
+        }
+    } else {
+        let _ = writeln!(
+            o,
+            "plate: {}, thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}{}{}",
+            match setup.model.element.surfaces() {
+                2 => "two surfaces (the paper's plate)".to_string(),
+                n => format!("{n} surfaces (displacement of degree {} through the thickness, 3D law)", n - 1),
+            },
+            num(setup.section.thickness()),
+            num(setup.section.delta_minus),
+            num(setup.section.delta_plus),
+            num(ps.young.expect("checked").0),
+            num(ps.nu.expect("checked").0),
+            format!("{:?}", ps.kinematics).to_lowercase(),
+            if ps.plane_strain { ", plane strain" } else { "" },
+            if setup.section.normal_stress == stamp_elements::NormalStress::Mean { ", mean S33 in the in-plane law" } else { "" },
+            if setup.section.shear_factor != 1.0 { format!(", shear factor {}", num(setup.section.shear_factor)) } else { String::new() }
+        );
+    }
     let nodal = setup.model.dofs.num_equations();
     let drives = setup.model.num_drives();
     let _ = writeln!(

@@ -5,7 +5,7 @@
 //! group `all`, and the point groups `corner_ll` (a, c), `corner_lr` (b, c), `corner_ur` (b, d),
 //! `corner_ul` (a, d) and, when nx and ny are even, `center`.
 
-use super::memory::{check_model_fits, dofs_per_node};
+use super::memory::check_model_fits;
 use super::problem::Problem;
 use super::rigid_modes::num;
 use stamp::io::read_msh;
@@ -45,7 +45,7 @@ impl MeshData {
             let r = spec.rectangle.as_ref().expect("checked: file or rectangle");
             // refused before its nodes are allocated when its model cannot fit
             let nodes = (r.n[0] as u64 + 1) * (r.n[1] as u64 + 1);
-            check_model_fits(nodes, dofs_per_node(p.spec.plate.get_ref().surfaces)).map_err(|e| {
+            check_model_fits(nodes, p.spec.plate.get_ref().dofs_per_node()).map_err(|e| {
                 // the `rectangle` key after the [mesh] header (its span is the header's)
                 let at = p.spec.mesh.span().start;
                 let at = p.source.get(at..).and_then(|t| t.find("rectangle")).map_or(at, |k| at + k);

@@ -1,5 +1,6 @@
-//! The plate model a problem file chooses (`[plate] surfaces`): the paper's two-surface plate or a
-//! plate of three to five surfaces through the thickness, plug-ins of the elements crate, behind
+//! The plate model a problem file chooses (`[plate] surfaces`, `layers`): the paper's two-surface
+//! plate, a plate of three to five surfaces through the thickness, or a laminate of layers of three
+//! to five surfaces each (interfaces shared), plug-ins of the elements crate, behind
 //! one [`Element`] for the rest of the run, with where each keeps its surfaces' displacements
 //! among the unknowns ([`Layout`]).
 
@@ -8,7 +9,10 @@ use stamp::mesh::QuadMesh;
 use stamp::Result;
 use stamp_elements::multi_surface::{lagrange, surface_zetas, MultiSurfaceWorkspace, Resultants};
 use stamp_elements::plate::PlateWorkspace;
-use stamp_elements::{FiveSurfacePlate, FourSurfacePlate, Kinematics, PlateElements, Section, ThreeSurfacePlate};
+use stamp_elements::laminate::LaminateWorkspace;
+use stamp_elements::{
+    FiveSurfaceLaminate, FiveSurfacePlate, FourSurfaceLaminate, FourSurfacePlate, Kinematics, Laminate, PlateElements, Section, ThreeSurfaceLaminate, ThreeSurfacePlate,
+};
 use stamp_elements::Face;
 
 /// The plate elements of a run.
@@ -21,6 +25,10 @@ pub enum Plate {
     FourSurface(FourSurfacePlate),
     /// Faces and three inner surfaces: quartic through the thickness.
     FiveSurface(FiveSurfacePlate),
+    /// Layers of three, four or five surfaces each.
+    ThreeSurfaceLayers(ThreeSurfaceLaminate),
+    FourSurfaceLayers(FourSurfaceLaminate),
+    FiveSurfaceLayers(FiveSurfaceLaminate),
 }
 
 /// The workspace of any of them.
@@ -29,6 +37,9 @@ pub enum PlateWs {
     ThreeSurface(MultiSurfaceWorkspace<12, 36>),
     FourSurface(MultiSurfaceWorkspace<16, 48>),
     FiveSurface(MultiSurfaceWorkspace<20, 60>),
+    ThreeSurfaceLayers(LaminateWorkspace<12, 36>),
+    FourSurfaceLayers(LaminateWorkspace<16, 48>),
+    FiveSurfaceLayers(LaminateWorkspace<20, 60>),
 }
 
 /// Dispatch `$body` on the plate's variant with the element bound to `$p`.
@@ -39,6 +50,9 @@ macro_rules! each {
             Plate::ThreeSurface($p) => $body,
             Plate::FourSurface($p) => $body,
             Plate::FiveSurface($p) => $body,
+            Plate::ThreeSurfaceLayers($p) => $body,
+            Plate::FourSurfaceLayers($p) => $body,
+            Plate::FiveSurfaceLayers($p) => $body,
         }
     };
 }
@@ -53,6 +67,24 @@ impl Plate {
             5 => Plate::FiveSurface(FiveSurfacePlate::new(mesh, section, kinematics)?),
             n => return Err(stamp::StampError::Material(format!("a plate has 2 to 5 surfaces, not {n}"))),
         })
+    }
+    /// The laminate of `per_layer` surfaces in each layer on `mesh`.
+    pub fn layered(per_layer: usize, mesh: &QuadMesh, laminate: Laminate, kinematics: Kinematics) -> Result<Plate> {
+        Ok(match per_layer {
+            3 => Plate::ThreeSurfaceLayers(ThreeSurfaceLaminate::new(mesh, laminate, kinematics)?),
+            4 => Plate::FourSurfaceLayers(FourSurfaceLaminate::new(mesh, laminate, kinematics)?),
+            5 => Plate::FiveSurfaceLayers(FiveSurfaceLaminate::new(mesh, laminate, kinematics)?),
+            n => return Err(stamp::StampError::Material(format!("a layer has 3 to 5 surfaces, not {n}"))),
+        })
+    }
+    /// The laminate and the surfaces in each of its layers, for a layered plate.
+    pub fn laminate(&self) -> Option<(&Laminate, usize)> {
+        match self {
+            Plate::ThreeSurfaceLayers(p) => Some((p.laminate(), 3)),
+            Plate::FourSurfaceLayers(p) => Some((p.laminate(), 4)),
+            Plate::FiveSurfaceLayers(p) => Some((p.laminate(), 5)),
+            _ => None,
+        }
     }
     /// Surfaces through the thickness.
     pub fn surfaces(&self) -> usize {
@@ -83,6 +115,9 @@ impl Plate {
             (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.resultants(e, v, w),
             (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.resultants(e, v, w),
             (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.resultants(e, v, w),
+            (Plate::ThreeSurfaceLayers(p), PlateWs::ThreeSurfaceLayers(w)) => p.resultants(e, v, w),
+            (Plate::FourSurfaceLayers(p), PlateWs::FourSurfaceLayers(w)) => p.resultants(e, v, w),
+            (Plate::FiveSurfaceLayers(p), PlateWs::FiveSurfaceLayers(w)) => p.resultants(e, v, w),
             _ => unreachable!("a workspace is made by its own plate"),
         }
     }
@@ -107,7 +142,30 @@ impl Layout {
         Layout { surfaces, dofs_per_node: 3 * surfaces, zetas, mid_weights }
     }
     pub fn of(plate: &Plate) -> Layout {
-        Layout::new(plate.surfaces())
+        match plate.laminate() {
+            Some((lam, per_layer)) => Layout::layered(lam, per_layer),
+            None => Layout::new(plate.surfaces()),
+        }
+    }
+    /// The layout of a laminate with `per_layer` surfaces in each layer: zeta = 2 x3 / h of the
+    /// surfaces in the order of the unknowns, the mid-plane x3 = 0 interpolated in the layer that
+    /// holds it.
+    pub fn layered(lam: &Laminate, per_layer: usize) -> Layout {
+        let h = lam.thickness();
+        let dof_order = lam.surfaces_in_dof_order(per_layer);
+        let upwards = lam.surfaces_upwards(per_layer);
+        let m = dof_order.len();
+        let zetas: Vec<f64> = dof_order.iter().map(|z| 2.0 * z / h).collect();
+        let k = lam.ply_at(0.0);
+        let own: Vec<f64> = (0..per_layer).map(|s| upwards[k * (per_layer - 1) + s]).collect();
+        let (l, _) = lagrange(&own, 0.0);
+        let mut mid_weights = vec![0.0; m];
+        for (s, w) in l.into_iter().enumerate() {
+            let j = k * (per_layer - 1) + s;
+            let slot = if j == 0 { 0 } else if j == m - 1 { 1 } else { j + 1 };
+            mid_weights[slot] = w;
+        }
+        Layout { surfaces: m, dofs_per_node: 3 * m, zetas, mid_weights }
     }
     /// The paper's six unknowns per node.
     pub fn two_surface() -> Layout {
@@ -180,6 +238,9 @@ impl Element for Plate {
             Plate::ThreeSurface(p) => PlateWs::ThreeSurface(p.new_workspace()),
             Plate::FourSurface(p) => PlateWs::FourSurface(p.new_workspace()),
             Plate::FiveSurface(p) => PlateWs::FiveSurface(p.new_workspace()),
+            Plate::ThreeSurfaceLayers(p) => PlateWs::ThreeSurfaceLayers(p.new_workspace()),
+            Plate::FourSurfaceLayers(p) => PlateWs::FourSurfaceLayers(p.new_workspace()),
+            Plate::FiveSurfaceLayers(p) => PlateWs::FiveSurfaceLayers(p.new_workspace()),
         }
     }
     fn evaluate(&self, e: usize, u: &[f64], ws: &mut PlateWs, out: &mut LocalSystem, with_tangent: bool) {
@@ -188,6 +249,9 @@ impl Element for Plate {
             (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
             (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
             (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
+            (Plate::ThreeSurfaceLayers(p), PlateWs::ThreeSurfaceLayers(w)) => p.evaluate(e, u, w, out, with_tangent),
+            (Plate::FourSurfaceLayers(p), PlateWs::FourSurfaceLayers(w)) => p.evaluate(e, u, w, out, with_tangent),
+            (Plate::FiveSurfaceLayers(p), PlateWs::FiveSurfaceLayers(w)) => p.evaluate(e, u, w, out, with_tangent),
             _ => unreachable!("a workspace is made by its own plate"),
         }
     }
@@ -218,5 +282,26 @@ mod tests {
         let by_surface: Vec<f64> = four.surface_displacements(&u, 0).iter().map(|d| d[0]).collect();
         assert_eq!(by_surface, vec![3.0, 5.0 - 2.0 / 3.0, 5.0 + 2.0 / 3.0, 7.0]);
         assert_eq!(two.surface_displacements(&(0..12).map(f64::from).collect::<Vec<_>>(), 1), vec![[6.0, 7.0, 8.0], [9.0, 10.0, 11.0]]);
+    }
+
+    /// A laminate's layout: the faces first, x3 = 0 interpolated in its own layer (here an
+    /// interface of two layers with three surfaces: that surface's unknowns alone; and inside the
+    /// middle layer of three).
+    #[test]
+    fn layered_layouts_interpolate_the_mid_plane_in_its_layer() {
+        use stamp_elements::{Isotropic, Ply, PlyMaterial};
+        let iso = PlyMaterial::Isotropic(Isotropic::new(1.0, 0.3).unwrap());
+        let ply = |t: f64| Ply { thickness: t, material: iso, angle: 0.0 };
+        let two = Layout::layered(&Laminate::new(vec![ply(0.5), ply(0.5)]).unwrap(), 3);
+        // surfaces upwards -0.5, -0.25, 0, 0.25, 0.5; in dof order -0.5, 0.5, -0.25, 0, 0.25
+        assert_eq!((two.surfaces, two.dofs_per_node), (5, 15));
+        assert_eq!(two.mid_terms(1, 2).collect::<Vec<_>>(), vec![(15 + 9 + 2, 1.0)]);
+        assert_eq!(two.fibre_components(&[2, 5]), vec![2, 5, 8, 11, 14]);
+        let three = Layout::layered(&Laminate::new(vec![ply(0.3), ply(0.2), ply(0.5)]).unwrap(), 4);
+        // a field linear in x3 is interpolated exactly: its mid value from the surfaces' values
+        let z: Vec<f64> = three.zetas.iter().map(|&zeta| 0.5 * zeta).collect();
+        let u: Vec<f64> = (0..3 * three.surfaces).map(|d| 3.0 * z[d / 3] + 2.0).collect();
+        assert!((three.mid_displacement(&u, 0)[0] - 2.0).abs() < 1e-14);
+        assert_eq!(three.mid_terms(0, 0).count(), 4, "the four surfaces of the middle layer");
     }
 }

@@ -322,6 +322,9 @@ pub struct ProblemFile {
     pub title: Option<String>,
     pub mesh: Spanned<MeshSpec>,
     pub plate: Spanned<PlateSpec>,
+    /// Materials of the layers (`[[material]]`, see laminate_spec.rs).
+    #[serde(default)]
+    pub material: Vec<Spanned<super::laminate_spec::MaterialSpec>>,
     #[serde(default)]
     pub boundary: Vec<Spanned<BoundarySpec>>,
     #[serde(default)]
@@ -479,9 +482,14 @@ pub struct PlateSpec {
     pub delta_minus: Option<Finite>,
     #[serde(default)]
     pub delta_plus: Option<Finite>,
-    #[serde(rename = "E")]
-    pub young: Positive,
-    pub nu: Poisson,
+    /// Young's modulus and Poisson's ratio of a homogeneous plate (not with `layers`).
+    #[serde(rename = "E", default)]
+    pub young: Option<Positive>,
+    #[serde(default)]
+    pub nu: Option<Poisson>,
+    /// The layers from the bottom face up (laminate_spec.rs); excludes `E`, `nu` and the thickness keys.
+    #[serde(default)]
+    pub layers: Option<Spanned<Vec<Spanned<super::laminate_spec::LayerSpec>>>>,
     #[serde(default)]
     pub kinematics: KinematicsSpec,
     /// v1- = v1+ = 0 at every node.
@@ -494,9 +502,23 @@ pub struct PlateSpec {
     #[serde(default)]
     pub normal_stress: stamp_elements::NormalStress,
     /// Surfaces through the thickness whose displacements are the unknowns: 2 (default, the
-    /// paper's plate) to 5.
+    /// paper's plate) to 5; with `layers`, the surfaces in each layer (3 to 5).
     #[serde(default)]
-    pub surfaces: Surfaces,
+    pub surfaces: Option<Surfaces>,
+}
+
+impl PlateSpec {
+    /// Surfaces through the thickness of a plate without layers (default 2).
+    pub fn surfaces(&self) -> usize {
+        self.surfaces.unwrap_or_default().0
+    }
+    /// Unknowns per node: 3 per surface; with L layers of N surfaces, 3 (L (N - 1) + 1).
+    pub fn dofs_per_node(&self) -> u64 {
+        match &self.layers {
+            Some(l) => 3 * (l.get_ref().len() as u64 * (self.surfaces().max(2) as u64 - 1) + 1),
+            None => 3 * self.surfaces() as u64,
+        }
+    }
 }
 
 /// `[plate] surfaces`: an integer from 2 to 5.
@@ -572,9 +594,10 @@ pub struct LoadSpec {
     /// line: per unit length; surface: per unit area; point: a force. At load factor 1.
     #[serde(default)]
     pub force: Option<Vec3>,
-    /// pressure: value at load factor 1, positive pushes on the face towards the plate.
+    /// pressure: value at load factor 1, positive pushes on the face towards the plate; a number
+    /// or an expression in x1, x2 (the syntax of a punch's `psi`).
     #[serde(default)]
-    pub pressure: Option<Finite>,
+    pub pressure: Option<Spanned<PressureSpec>>,
     #[serde(default)]
     pub face: Option<LoadFace>,
     /// moment: couple per unit length [m1, m2, m3] at load factor 1 (right-hand rule).
@@ -583,6 +606,41 @@ pub struct LoadSpec {
     /// pressure, moment: the load follows the deformation (default false: a dead load).
     #[serde(default)]
     pub follower: bool,
+}
+
+/// A pressure: one number, or an expression in x1, x2.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PressureSpec {
+    Uniform(f64),
+    Expression(String),
+}
+
+impl<'de> Deserialize<'de> for PressureSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Number(f64),
+            Text(String),
+        }
+        match Raw::deserialize(d).map_err(|_| D::Error::custom("expected a number or an expression in x1, x2 (a string, e.g. \"sin(pi*x1/10)*sin(pi*x2/10)\")"))? {
+            Raw::Number(v) if v.is_finite() && v.abs() <= limits::MAX_MAGNITUDE => Ok(PressureSpec::Uniform(v)),
+            Raw::Number(v) => Err(D::Error::custom(format!("expected a finite number of magnitude at most 1e100, got {}", num(v)))),
+            Raw::Text(t) => Ok(PressureSpec::Expression(t)),
+        }
+    }
+}
+
+/// Whether an expression uses x3.
+fn uses_x3(node: &stamp_contact::expression_parser::Node) -> bool {
+    use stamp_contact::expression_parser::Node;
+    match node {
+        Node::Var(i) => *i == 2,
+        Node::Const(_) => false,
+        Node::Neg(a) => uses_x3(a),
+        Node::Bin(_, a, b) => uses_x3(a) || uses_x3(b),
+        Node::Call(_, args) => args.iter().any(uses_x3),
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -1070,7 +1128,15 @@ impl Problem {
     fn check_rest(&self) -> Result<()> {
         let s = &self.spec;
         let plate = s.plate.get_ref();
+        if super::laminate_spec::laminate(self)?.is_none() {
+            for (k, given) in [("E", plate.young.is_some()), ("nu", plate.nu.is_some())] {
+                if !given {
+                    return Err(self.error_at(s.plate.span(), &format!("plate.{k}"), "missing: give E and nu of a homogeneous plate, or `layers` with [[material]] tables"));
+                }
+            }
+        }
         match (plate.thickness, plate.delta_minus, plate.delta_plus) {
+            _ if plate.layers.is_some() => {}
             (Some(_), None, None) => {}
             (None, Some(a), Some(b)) => {
                 if !(b.0 > a.0) {
@@ -1097,6 +1163,17 @@ impl Problem {
                     }
                     if ls.face.is_none() || ls.face == Some(LoadFace::Mid) {
                         return Err(self.error_at(l.span(), &format!("{key}.face"), "a pressure acts on face = \"top\" or \"bottom\""));
+                    }
+                    let q = ls.pressure.as_ref().unwrap();
+                    if let PressureSpec::Expression(text) = q.get_ref() {
+                        let spanned = Spanned::new(q.span(), text.clone());
+                        match stamp_contact::expression_parser::parse(text) {
+                            Err(e) => return Err(self.psi_error(&spanned, e.column, &format!("{key}.pressure"), &e.message)),
+                            Ok(node) if uses_x3(&node) => {
+                                return Err(self.error_at(q.span(), &format!("{key}.pressure"), "a pressure over the plate is a function of x1 and x2; it cannot use x3"));
+                            }
+                            Ok(_) => {}
+                        }
                     }
                 }
                 LoadKind::Moment => {

@@ -100,7 +100,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     }
     // every refined model must fit before anything is solved
     let sizes = stamp::mesh::refine::refined_sizes(&setup.mesh.mesh, levels);
-    check_levels_fit(&sizes, levels, super::memory::dofs_per_node(p.spec.plate.get_ref().surfaces), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
+    check_levels_fit(&sizes, levels, p.spec.plate.get_ref().dofs_per_node(), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
     // the folder is this run's until the last mesh is solved (the runs below claim it again)
     std::fs::create_dir_all(&out_dir).map_err(|e| StampError::io(&out_dir, e))?;

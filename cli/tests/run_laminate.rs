@@ -1,0 +1,189 @@
+//! Laminates through problem files: `[[material]]` tables and `[plate] layers` with `surfaces` per
+//! layer, a pressure written as an expression in x1, x2. Pagano's cross-ply plate run by the
+//! program against the exact 3D solution; a squeezed orthotropic stack against 3D elasticity's
+//! uniform state; `stamp check` listing the stack; the keys refused with their names.
+
+#[path = "../../tests/common/pagano.rs"]
+#[allow(dead_code)]
+mod pagano;
+mod common;
+use common::*;
+use serde_json::Value;
+use stamp_cli::run::{build::build, Problem};
+use stamp_elements::orthotropic::rotate;
+use stamp_elements::{Orthotropic, PlyMaterial};
+
+fn last_step(out: &std::path::Path) -> Value {
+    summary(out)["steps"].as_array().unwrap().last().unwrap().clone()
+}
+
+const PLY: &str = r#"[[material]]
+name = "ply"
+E = [25.0, 1.0, 1.0]
+G = [0.5, 0.5, 0.2]
+nu = [0.25, 0.25, 0.25]
+"#;
+
+/// The quarter [0, a/2]^2 of Pagano's simply supported square [0/90/90/0] plate (a = 10, h = 1)
+/// under q0 sin(pi x1/a) sin(pi x2/a) on the top face, diaphragm supports (v2, v3 on x1 = 0; v1, v3
+/// on x2 = 0: both faces, hence the whole fibre), symmetry on the other two edges.
+fn pagano_problem(n: usize, per_layer: usize) -> String {
+    format!(
+        r#"[mesh]
+rectangle = {{ x = [0.0, 5.0], y = [0.0, 5.0], n = [{n}, {n}] }}
+
+{PLY}
+[plate]
+layers = [
+  {{ thickness = 0.25, material = "ply", angle = 0.0 }},
+  {{ thickness = 0.25, material = "ply", angle = 90.0 }},
+  {{ thickness = 0.25, material = "ply", angle = 90.0 }},
+  {{ thickness = 0.25, material = "ply", angle = 0.0 }},
+]
+surfaces = {per_layer}
+kinematics = "linear"
+
+[[boundary]]
+group = "left"
+fix = ["v2", "v3"]
+
+[[boundary]]
+group = "bottom"
+fix = ["v1", "v3"]
+
+[[boundary]]
+group = "right"
+fix = ["symmetry_x1"]
+
+[[boundary]]
+group = "top"
+fix = ["symmetry_x2"]
+
+[[load]]
+type = "pressure"
+group = "all"
+pressure = "sin(pi*x1/10)*sin(pi*x2/10)"
+face = "top"
+"#
+    )
+}
+
+/// The program's centre deflection within 0.1 % of the exact one (the element's own convergence
+/// is in tests/laminate_pagano.rs); `stamp check` lists the stack.
+#[test]
+fn paganos_plate_through_a_problem_file() {
+    let dir = temp_dir("laminate-pagano");
+    let path = write(&dir, "pagano.toml", &pagano_problem(12, 4));
+    let p = Problem::read(&path).unwrap();
+    let setup = build(&p).unwrap();
+    let report = stamp_cli::run::check::check(&p, &setup).unwrap().summary;
+    for want in ["4 layers of 4 surfaces each (13 surfaces", "layer 0: x3 from -0.5 to -0.25", "'ply' (orthotropic E = [25, 1, 1]", "angle 90 degrees"] {
+        assert!(report.contains(want), "'{want}' missing from the summary:\n{report}");
+    }
+    let out = dir.join("out");
+    stamp_cli::run::run(&path, Some(&out), true).unwrap();
+    assert_eq!(summary(&out)["surfaces"].as_u64(), Some(13));
+    let w = last_step(&out)["points"]["corner_ur"]["displacement"][2].as_f64().unwrap();
+    let m = PlyMaterial::Orthotropic(Orthotropic::new([25.0, 1.0, 1.0], [0.5, 0.5, 0.2], [0.25; 3]).unwrap());
+    let layers = [0.0, 90.0, 90.0, 0.0].map(|a: f64| pagano::Layer { thickness: 0.25, c: rotate(&m.stiffness(), a.to_radians()) }).to_vec();
+    // the exact solution for an upward load; the problem's pressure pushes down
+    let exact = -pagano::Pagano::new(layers, 10.0, 10.0, 1.0).displacement(5.0, 5.0, 0.0)[2];
+    println!("centre deflection {w}, exact {exact} ({:+.4} %)", 100.0 * (w / exact - 1.0));
+    assert!((w / exact - 1.0).abs() < 1e-3, "centre deflection {w} against the exact {exact}");
+}
+
+/// Two plies of one orthotropic material turned by 90 degrees, on a frictionless rigid base
+/// (v3- = 0), pressed by q on the top face, free to spread: 3D elasticity gives the uniform state
+/// S33 = -q, so the plate thins by q h / E3 and spreads by nu23 q / E2 along x1 (the plies' axis 2)
+/// and nu13 q / E1 along x2 (their fibres). Exact for any number of surfaces.
+#[test]
+fn a_squeezed_orthotropic_stack_is_3d_elasticity_exactly() {
+    let dir = temp_dir("laminate-squeeze");
+    let (e1, e2, e3, n13, n23, q, h) = (25.0, 1.0, 1.3, 0.3, 0.35, 0.01, 0.2);
+    for per_layer in [3, 5] {
+        let text = format!(
+            r#"[mesh]
+rectangle = {{ x = [0.0, 1.0], y = [0.0, 1.0], n = [3, 2] }}
+
+[[material]]
+name = "ply"
+E = [{e1}, {e2}, {e3}]
+G = [0.5, 0.4, 0.2]
+nu = [0.25, {n13}, {n23}]
+
+[plate]
+layers = [{{ thickness = 0.1, material = "ply", angle = 90.0 }}, {{ thickness = 0.1, material = "ply", angle = 90.0 }}]
+surfaces = {per_layer}
+kinematics = "linear"
+
+[[boundary]]
+group = "all"
+fix = ["v3-"]
+
+[[boundary]]
+group = "left"
+fix = ["symmetry_x1"]
+
+[[boundary]]
+group = "bottom"
+fix = ["symmetry_x2"]
+
+[[load]]
+type = "pressure"
+group = "all"
+pressure = {q}
+face = "top"
+"#
+        );
+        let path = write(&dir, &format!("s{per_layer}.toml"), &text);
+        let out = dir.join(format!("s{per_layer}"));
+        stamp_cli::run::run(&path, Some(&out), true).unwrap();
+        let corner = &last_step(&out)["points"]["corner_ur"];
+        let top = corner["displacement_top"][2].as_f64().unwrap();
+        assert!((top + q * h / e3).abs() <= 1e-8 * q * h / e3, "{per_layer}: the top face moves by {top}, 3D: {}", -q * h / e3);
+        for (c, want) in [(0, n23 * q / e2), (1, n13 * q / e1)] {
+            let u = corner["displacement"][c].as_f64().unwrap();
+            assert!((u - want).abs() <= 1e-8 * want, "{per_layer}: the corner moves by {u} along x{}, 3D: {want}", c + 1);
+        }
+    }
+}
+
+/// The keys of laminates refused with the key's name and the reason.
+#[test]
+fn bad_laminate_keys_are_refused_by_name() {
+    let dir = temp_dir("laminate-keys");
+    let good = pagano_problem(2, 3);
+    for (name, text, want) in [
+        ("with_e", good.replace("surfaces = 3", "surfaces = 3\nE = 1.0"), vec!["plate.E", "`layers` and `E` exclude each other"]),
+        ("with_h", good.replace("surfaces = 3", "surfaces = 3\nthickness = 1.0"), vec!["plate.thickness", "exclude each other"]),
+        ("no_surfaces", good.replace("surfaces = 3\n", ""), vec!["plate.surfaces", "3 to 5"]),
+        ("two_surfaces", good.replace("surfaces = 3", "surfaces = 2"), vec!["plate.surfaces", "3 to 5, got 2"]),
+        ("unknown", good.replacen("material = \"ply\", angle = 90.0", "material = \"carbon\", angle = 90.0", 1), vec!["plate.layers[1].material", "no [[material]] is named 'carbon'", "'ply'"]),
+        ("no_g", good.replace("G = [0.5, 0.5, 0.2]\n", ""), vec!["material[0].G", "orthotropic"]),
+        ("iso_g", good.replace("E = [25.0, 1.0, 1.0]", "E = 25.0"), vec!["material[0].G", "isotropic"]),
+        ("two_e", good.replace("E = [25.0, 1.0, 1.0]", "E = [25.0, 1.0]"), vec!["E", "three numbers", "got 2"]),
+        ("unstable", good.replace("nu = [0.25, 0.25, 0.25]", "nu = [0.25, 0.25, 1.5]"), vec!["material[0]", "not positive definite"]),
+        ("thin", good.replacen("thickness = 0.25", "thickness = -0.25", 1), vec!["plate.layers[0].thickness", "positive"]),
+        ("unused", pagano_problem(2, 3).replace("layers = [", "E = 1.0\nnu = 0.3\nthickness = 1.0\nxlayers = ["), vec!["unknown field `xlayers`"]),
+        ("no_e", good.replace("layers = [", "xx = [").replace("surfaces = 3", ""), vec!["unknown field `xx`"]),
+        ("expression", good.replace("sin(pi*x1/10)", "sin(pi*x1/10"), vec!["load[0].pressure", "')'"]),
+        ("x3", good.replace("sin(pi*x1/10)", "sin(pi*x3/10)"), vec!["load[0].pressure", "cannot use x3"]),
+    ] {
+        let path = write(&dir, &format!("{name}.toml"), &text);
+        let err = match Problem::read(&path).and_then(|p| build(&p).map(|_| ())) {
+            Ok(()) => panic!("{name}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(&format!("{name}.toml")), "{name}: the file is not named: {err}");
+        for w in want {
+            assert!(err.contains(w), "{name}: '{w}' missing from: {err}");
+        }
+    }
+    // a [[material]] without layers
+    let text = format!("{}\n{PLY}", include_str!("../../meshes/sphere-ss-displacement.toml"));
+    let err = Problem::parse(std::path::Path::new("m.toml"), text).err().expect("refused").to_string();
+    assert!(err.contains("material[0]") && err.contains("[plate] layers"), "{err}");
+    // E without nu in a homogeneous plate
+    let err = Problem::parse(std::path::Path::new("n.toml"), include_str!("../../meshes/sphere-ss-displacement.toml").replace("nu = 0.3", "")).err().expect("refused").to_string();
+    assert!(err.contains("plate.nu") && err.contains("missing"), "{err}");
+}
