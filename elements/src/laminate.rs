@@ -108,6 +108,13 @@ impl Laminate {
         z
     }
 
+    /// The slots, in the order of the unknowns, of the `per_layer` surfaces of ply `k` from its
+    /// bottom up.
+    pub fn ply_slots(&self, per_layer: usize, k: usize) -> Vec<usize> {
+        let m = self.plies.len() * (per_layer - 1) + 1;
+        (0..per_layer).map(|s| slot_of_upward(k * (per_layer - 1) + s, m)).collect()
+    }
+
     /// The ply that holds x3 (the upper one at an interface, the top ply at the top face).
     pub fn ply_at(&self, x3: f64) -> usize {
         let b = self.boundaries();

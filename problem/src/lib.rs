@@ -49,6 +49,7 @@ pub mod richardson;
 pub mod rigid_modes;
 pub mod solve;
 pub mod table;
+pub mod thickness_probe;
 pub mod travel_modes;
 pub mod units;
 pub mod stdout;

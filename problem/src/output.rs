@@ -164,6 +164,56 @@ pub struct ContactRow {
     pub active: bool,
 }
 
+/// The names of the cell arrays of a run's .vtu: the resultants, and with layers the stresses at
+/// every surface of every layer (see [`layer_stress_fields`]).
+pub fn cell_array_names(plate: &Plate) -> Vec<String> {
+    let mut v: Vec<String> = CELL_ARRAYS.iter().map(|s| s.to_string()).collect();
+    if let Some((lam, per_layer)) = plate.laminate() {
+        for k in 0..lam.plies.len() {
+            for s in 0..per_layer {
+                v.push(stress_field_name(k, s));
+            }
+        }
+    }
+    v
+}
+
+fn stress_field_name(layer: usize, surface: usize) -> String {
+    format!("stress_layer{layer}_surface{surface}")
+}
+
+/// With layers: per layer k and surface s of it (from its bottom up, its faces included: an
+/// interface in each of its two layers), `stress_layer<k>_surface<s>`, the six second
+/// Piola-Kirchhoff stresses in the plate's axes at the element centre (the mean over its Gauss
+/// points) by the layer's 3D law, as a symmetric tensor in VTK's order [s11, s22, s33, s12, s23, s13].
+pub fn layer_stress_fields(model: &Model<Plate>, u: &[f64]) -> Vec<Field> {
+    let plate = &model.element;
+    let Some((lam, per_layer)) = plate.laminate() else {
+        return Vec::new();
+    };
+    let b = lam.boundaries();
+    let mut ws = plate.new_workspace();
+    let ne = plate.num_elements();
+    let dpn = plate.dofs_per_node();
+    let nl = lam.plies.len();
+    let mut out: Vec<Vec<f64>> = vec![Vec::with_capacity(6 * ne); nl * per_layer];
+    let mut local = vec![0.0; 4 * dpn];
+    for e in 0..ne {
+        for (a, &n) in plate.element_nodes(e).iter().enumerate() {
+            local[dpn * a..dpn * (a + 1)].copy_from_slice(&u[dpn * n..dpn * (n + 1)]);
+        }
+        for k in 0..nl {
+            for s in 0..per_layer {
+                let x3 = b[k] + (b[k + 1] - b[k]) * s as f64 / (per_layer - 1) as f64;
+                let g = plate.layer_stresses(e, k, x3, &local, &mut ws).expect("a laminate");
+                let mean = |c: usize| 0.25 * g.iter().map(|p| p[c]).sum::<f64>();
+                out[k * per_layer + s].extend([mean(0), mean(1), mean(2), mean(5), mean(3), mean(4)]);
+            }
+        }
+    }
+    out.into_iter().enumerate().map(|(i, v)| Field::new(stress_field_name(i / per_layer, i % per_layer), 6, v)).collect()
+}
+
 /// Stress resultants at the element centres.
 pub fn cell_fields(model: &Model<Plate>, u: &[f64]) -> Vec<Field> {
     let plate = &model.element;
@@ -182,7 +232,9 @@ pub fn cell_fields(model: &Model<Plate>, u: &[f64]) -> Vec<Field> {
             out[k].push(*v);
         }
     }
-    CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect()
+    let mut fields: Vec<Field> = CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect();
+    fields.extend(layer_stress_fields(model, u));
+    fields
 }
 
 /// Inputs of [`step_data`] that do not change from step to step.

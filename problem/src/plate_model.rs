@@ -86,6 +86,17 @@ impl Plate {
             _ => None,
         }
     }
+    /// The six stresses (Voigt order [11, 22, 33, 23, 13, 12], the plate's axes) at height `x3` of
+    /// layer `k` of element `e` at its four Gauss points, by the layer's 3D law; None for a plate
+    /// without layers.
+    pub fn layer_stresses(&self, e: usize, k: usize, x3: f64, v: &[f64], ws: &mut PlateWs) -> Option<[[f64; 6]; 4]> {
+        match (self, ws) {
+            (Plate::ThreeSurfaceLayers(p), PlateWs::ThreeSurfaceLayers(w)) => Some(p.stresses_at(e, k, x3, v, w)),
+            (Plate::FourSurfaceLayers(p), PlateWs::FourSurfaceLayers(w)) => Some(p.stresses_at(e, k, x3, v, w)),
+            (Plate::FiveSurfaceLayers(p), PlateWs::FiveSurfaceLayers(w)) => Some(p.stresses_at(e, k, x3, v, w)),
+            _ => None,
+        }
+    }
     /// Surfaces through the thickness.
     pub fn surfaces(&self) -> usize {
         Element::dofs_per_node(self) / 3

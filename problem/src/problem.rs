@@ -824,6 +824,9 @@ pub struct OutputSpec {
     /// Lines along which the fields are sampled (see probe.rs).
     #[serde(default)]
     pub probe: Vec<Spanned<ProbeSpec>>,
+    /// Points whose fields through the thickness are written (see thickness_probe.rs).
+    #[serde(default)]
+    pub thickness_probe: Vec<Spanned<super::thickness_probe::ThicknessProbeSpec>>,
 }
 
 fn yes() -> bool {
@@ -844,6 +847,7 @@ impl Default for OutputSpec {
             every_step: true,
             loaded_threshold: default_threshold(),
             probe: Vec::new(),
+            thickness_probe: Vec::new(),
         }
     }
 }
@@ -1277,6 +1281,7 @@ impl Problem {
         }
         self.check_increments()?;
         check_probes(self, &s.output.probe)?;
+        super::thickness_probe::check(self, &s.output.thickness_probe)?;
         if s.output.plot_axis == PlotAxis::Arc && s.output.plot_group.is_none() {
             return Err(StampError::Input {
                 file: self.path.display().to_string(),

@@ -342,6 +342,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.is_some() || c.motion.is_zero())).collect();
     let mut history = History::new(&punch_keys, &point_groups).with_layout(Layout::of(&model.element));
     let mut probes = Probes::new(p, &mesh, &out.probe, &punch_names)?;
+    let thickness_probes = super::thickness_probe::ThicknessProbes::new(p, &mesh)?;
 
     let mut summary = Summary {
         problem: p.path.display().to_string(),
@@ -383,7 +384,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         failed_iterations: 0,
         seconds: 0.0,
         point_arrays: super::output::POINT_ARRAYS.iter().filter(|n| **n != "gap" || !punches.is_empty()).map(|s| s.to_string()).collect(),
-        cell_arrays: super::output::CELL_ARRAYS.iter().map(|s| s.to_string()).collect(),
+        cell_arrays: super::output::cell_array_names(&model.element),
         coarse_predictor: None,
         refinement: opts.refinement.clone(),
         steps: Vec::new(),
@@ -504,6 +505,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
                     written.push(path);
                     data.entry.csv.push(name);
                 }
+            }
+            for path in thickness_probes.write_step(out_dir, rep.step, m, u)? {
+                data.entry.csv.push(path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default());
+                written.push(path);
             }
             for path in probes.write_step(out_dir, rep.step, &row, &punch_names, &m.contacts, &history.layout, u)? {
                 data.entry.csv.push(path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default());
