@@ -174,6 +174,8 @@ fn paganos_plate_through_a_problem_file() {
     let out = dir.join("out");
     stamp_cli::run::run(&path, Some(&out), true).unwrap();
     assert_eq!(summary(&out)["surfaces"].as_u64(), Some(13));
+    let layers = summary(&out)["layers"].clone();
+    assert_eq!(layers[1], serde_json::json!({"bottom": -0.25, "top": 0.0, "material": "ply", "angle": 90.0, "surfaces": 4}), "{layers}");
     let arrays = summary(&out)["cell_arrays"].clone();
     assert!(arrays.as_array().unwrap().iter().any(|a| a == "stress_layer3_surface3"), "{arrays}");
     let vtu = std::fs::read_to_string(out.join("pagano_0001.vtu")).unwrap();

@@ -1135,7 +1135,7 @@ impl Problem {
         if super::laminate_spec::laminate(self)?.is_none() {
             for (k, given) in [("E", plate.young.is_some()), ("nu", plate.nu.is_some())] {
                 if !given {
-                    return Err(self.error_at(s.plate.span(), &format!("plate.{k}"), "missing: give E and nu of a homogeneous plate, or `layers` with [[material]] tables"));
+                    return Err(self.error_at(s.plate.span(), &format!("plate.{k}"), format!("missing field `{k}`: give E and nu of a homogeneous plate, or `layers` with [[material]] tables")));
                 }
             }
         }

@@ -99,8 +99,13 @@ struct Summary {
     nodes: usize,
     cells: usize,
     equations: usize,
-    /// `[plate] surfaces`: 2 (the paper's plate) to 5.
+    /// Surfaces through the thickness: `[plate] surfaces`, 2 (the paper's plate) to 5; with
+    /// layers, all of them (L (N - 1) + 1).
     surfaces: usize,
+    /// With `[plate] layers`: the stack from the bottom up (x3 of each layer's faces, its
+    /// material's name, angle and surfaces); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    layers: Option<Value>,
     thickness: f64,
     delta_minus: f64,
     delta_plus: f64,
@@ -355,6 +360,17 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         cells: mesh.mesh.num_cells(),
         equations: model.dofs.num_equations(),
         surfaces: model.element.surfaces(),
+        layers: model.element.laminate().map(|(lam, per_layer)| {
+            let names: Vec<String> = p.spec.plate.get_ref().layers.as_ref().map(|l| l.get_ref().iter().map(|s| s.get_ref().material.clone()).collect()).unwrap_or_default();
+            let b = lam.boundaries();
+            Value::Array(
+                lam.plies
+                    .iter()
+                    .enumerate()
+                    .map(|(k, ply)| serde_json::json!({"bottom": b[k], "top": b[k + 1], "material": names.get(k), "angle": ply.angle, "surfaces": per_layer}))
+                    .collect(),
+            )
+        }),
         thickness: section.thickness(),
         delta_minus: section.delta_minus,
         delta_plus: section.delta_plus,
