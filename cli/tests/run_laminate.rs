@@ -278,7 +278,7 @@ fn bad_laminate_keys_are_refused_by_name() {
     }
     // a [[material]] without layers
     let text = format!("{}\n{PLY}", include_str!("../../meshes/sphere-ss-displacement.toml"));
-    let err = Problem::parse(std::path::Path::new("m.toml"), text).err().expect("refused").to_string();
+    let err = Problem::parse(std::path::Path::new("m.toml"), text).and_then(|p| build(&p).map(|_| ())).err().expect("refused").to_string();
     assert!(err.contains("material[0]") && err.contains("[plate] layers"), "{err}");
     // E without nu in a homogeneous plate
     let err = Problem::parse(std::path::Path::new("n.toml"), include_str!("../../meshes/sphere-ss-displacement.toml").replace("nu = 0.3", "")).err().expect("refused").to_string();

@@ -308,7 +308,7 @@ mod tests {
         assert_eq!((two.surfaces, two.dofs_per_node), (5, 15));
         assert_eq!(two.mid_terms(1, 2).collect::<Vec<_>>(), vec![(15 + 9 + 2, 1.0)]);
         assert_eq!(two.fibre_components(&[2, 5]), vec![2, 5, 8, 11, 14]);
-        let three = Layout::layered(&Laminate::new(vec![ply(0.3), ply(0.2), ply(0.5)]).unwrap(), 4);
+        let three = Layout::layered(&Laminate::new(vec![ply(0.3), ply(0.4), ply(0.3)]).unwrap(), 4);
         // a field linear in x3 is interpolated exactly: its mid value from the surfaces' values
         let z: Vec<f64> = three.zetas.iter().map(|&zeta| 0.5 * zeta).collect();
         let u: Vec<f64> = (0..3 * three.surfaces).map(|d| 3.0 * z[d / 3] + 2.0).collect();

@@ -324,7 +324,7 @@ pub struct ProblemFile {
     pub plate: Spanned<PlateSpec>,
     /// Materials of the layers (`[[material]]`, see laminate_spec.rs).
     #[serde(default)]
-    pub material: Vec<Spanned<super::laminate_spec::MaterialSpec>>,
+    pub material: Vec<Spanned<MaterialSpec>>,
     #[serde(default)]
     pub boundary: Vec<Spanned<BoundarySpec>>,
     #[serde(default)]
@@ -391,6 +391,95 @@ pub fn check_probes(p: &Problem, probes: &[Spanned<ProbeSpec>]) -> Result<()> {
         if let Some(n) = spec.points {
             if !(2..=100_000).contains(&n) {
                 return Err(p.error_at(s.span(), &format!("{key}.points"), format!("expected 2 to 100000 points, got {n}")));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A number or three numbers, as written.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OneOrThree {
+    One(f64),
+    Three([f64; 3]),
+}
+
+impl<'de> Deserialize<'de> for OneOrThree {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            One(f64),
+            Many(Vec<f64>),
+        }
+        const FORMS: &str = "expected a number (isotropic) or three numbers [1, 2, 3] in the ply's axes (orthotropic)";
+        match Raw::deserialize(d).map_err(|_| D::Error::custom(FORMS))? {
+            Raw::One(v) if v.is_finite() => Ok(OneOrThree::One(v)),
+            Raw::Many(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => Ok(OneOrThree::Three([v[0], v[1], v[2]])),
+            Raw::Many(v) if v.len() == 3 => Err(D::Error::custom("expected three finite numbers")),
+            Raw::Many(v) => Err(D::Error::custom(format!("{FORMS}, got {} numbers", v.len()))),
+            Raw::One(_) => Err(D::Error::custom("expected a finite number")),
+        }
+    }
+}
+
+/// One `[[material]]` table (turned into a laminate by laminate_spec.rs).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    pub name: String,
+    #[serde(rename = "E")]
+    pub young: OneOrThree,
+    #[serde(rename = "G", default)]
+    pub shear: Option<OneOrThree>,
+    pub nu: OneOrThree,
+}
+
+/// One entry of `[plate] layers`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerSpec {
+    pub thickness: f64,
+    pub material: String,
+    #[serde(default)]
+    pub angle: f64,
+}
+
+/// The default rows per layer.
+pub const DEFAULT_POINTS_PER_LAYER: usize = 9;
+
+/// One `[[output.thickness_probe]]` table (the probe itself: thickness_probe.rs).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThicknessProbeSpec {
+    pub name: String,
+    pub at: [f64; 2],
+    #[serde(default)]
+    pub points_per_layer: Option<usize>,
+}
+
+/// Names, points and counts, with file, line and key; a laminate is needed.
+pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>]) -> Result<()> {
+    let mut names = std::collections::BTreeSet::new();
+    for (i, s) in probes.iter().enumerate() {
+        let spec = s.get_ref();
+        let key = format!("output.thickness_probe[{i}]");
+        if p.spec.plate.get_ref().layers.is_none() {
+            return Err(p.error_at(s.span(), &key, "the stresses through the thickness are those of a laminate's layers: the plate needs `layers`"));
+        }
+        let name = &spec.name;
+        if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("{} must be 1 to 64 letters, digits, '_' or '-' (it names files)", stamp::quote(name))));
+        }
+        if !names.insert(name.clone()) {
+            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("two thickness probes are named {}", stamp::quote(name))));
+        }
+        if spec.at.iter().any(|v| !v.is_finite()) {
+            return Err(p.error_at(s.span(), &format!("{key}.at"), format!("must be two finite numbers, got {:?}", spec.at)));
+        }
+        if let Some(n) = spec.points_per_layer {
+            if !(2..=1000).contains(&n) {
+                return Err(p.error_at(s.span(), &format!("{key}.points_per_layer"), format!("expected 2 to 1000 points (the layer's faces among them), got {n}")));
             }
         }
     }
@@ -489,7 +578,7 @@ pub struct PlateSpec {
     pub nu: Option<Poisson>,
     /// The layers from the bottom face up (laminate_spec.rs); excludes `E`, `nu` and the thickness keys.
     #[serde(default)]
-    pub layers: Option<Spanned<Vec<Spanned<super::laminate_spec::LayerSpec>>>>,
+    pub layers: Option<Spanned<Vec<Spanned<LayerSpec>>>>,
     #[serde(default)]
     pub kinematics: KinematicsSpec,
     /// v1- = v1+ = 0 at every node.
@@ -826,7 +915,7 @@ pub struct OutputSpec {
     pub probe: Vec<Spanned<ProbeSpec>>,
     /// Points whose fields through the thickness are written (see thickness_probe.rs).
     #[serde(default)]
-    pub thickness_probe: Vec<Spanned<super::thickness_probe::ThicknessProbeSpec>>,
+    pub thickness_probe: Vec<Spanned<ThicknessProbeSpec>>,
 }
 
 fn yes() -> bool {
@@ -1132,7 +1221,7 @@ impl Problem {
     fn check_rest(&self) -> Result<()> {
         let s = &self.spec;
         let plate = s.plate.get_ref();
-        if super::laminate_spec::laminate(self)?.is_none() {
+        if plate.layers.is_none() {
             for (k, given) in [("E", plate.young.is_some()), ("nu", plate.nu.is_some())] {
                 if !given {
                     return Err(self.error_at(s.plate.span(), &format!("plate.{k}"), format!("missing field `{k}`: give E and nu of a homogeneous plate, or `layers` with [[material]] tables")));
@@ -1281,7 +1370,7 @@ impl Problem {
         }
         self.check_increments()?;
         check_probes(self, &s.output.probe)?;
-        super::thickness_probe::check(self, &s.output.thickness_probe)?;
+        check_thickness_probes(self, &s.output.thickness_probe)?;
         if s.output.plot_axis == PlotAxis::Arc && s.output.plot_group.is_none() {
             return Err(StampError::Input {
                 file: self.path.display().to_string(),

@@ -13,55 +13,12 @@
 use super::mesh::MeshData;
 use super::plate_model::Plate;
 use super::probe::CellLocator;
-use super::problem::Problem;
-use toml::Spanned;
-use serde::Deserialize;
+use super::problem::{Problem, DEFAULT_POINTS_PER_LAYER};
 use stamp::element::Element;
 use stamp::io::write_string_atomically;
 use stamp::model::Model;
 use stamp::{Result, StampError};
 use std::path::{Path, PathBuf};
-
-/// The default rows per layer.
-pub const DEFAULT_POINTS_PER_LAYER: usize = 9;
-
-/// One `[[output.thickness_probe]]` table.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ThicknessProbeSpec {
-    pub name: String,
-    pub at: [f64; 2],
-    #[serde(default)]
-    pub points_per_layer: Option<usize>,
-}
-
-/// Names, points and counts, with file, line and key; a laminate is needed.
-pub fn check(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>]) -> Result<()> {
-    let mut names = std::collections::BTreeSet::new();
-    for (i, s) in probes.iter().enumerate() {
-        let spec = s.get_ref();
-        let key = format!("output.thickness_probe[{i}]");
-        if p.spec.plate.get_ref().layers.is_none() {
-            return Err(p.error_at(s.span(), &key, "the stresses through the thickness are those of a laminate's layers: the plate needs `layers`"));
-        }
-        let name = &spec.name;
-        if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("{} must be 1 to 64 letters, digits, '_' or '-' (it names files)", stamp::quote(name))));
-        }
-        if !names.insert(name.clone()) {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("two thickness probes are named {}", stamp::quote(name))));
-        }
-        if spec.at.iter().any(|v| !v.is_finite()) {
-            return Err(p.error_at(s.span(), &format!("{key}.at"), format!("must be two finite numbers, got {:?}", spec.at)));
-        }
-        if let Some(n) = spec.points_per_layer {
-            if !(2..=1000).contains(&n) {
-                return Err(p.error_at(s.span(), &format!("{key}.points_per_layer"), format!("expected 2 to 1000 points (the layer's faces among them), got {n}")));
-            }
-        }
-    }
-    Ok(())
-}
 
 struct Item {
     name: String,
