@@ -12,7 +12,7 @@ pub struct KeptStep {
     pub load_factor: f64,
     /// The .vtu's point arrays ([`super::output::POINT_ARRAYS`]).
     pub point_fields: Vec<Field>,
-    /// The .vtu's cell arrays ([`super::output::CELL_ARRAYS`]).
+    /// The .vtu's cell arrays ([`super::output::cell_array_names`]: the resultants, and with layers the stresses).
     pub cell_fields: Vec<Field>,
     /// Per punch (in the order of [`Kept::punches`]), q_n at every node (0 off its candidates): the
     /// pressure column of its pressure_*.csv.
