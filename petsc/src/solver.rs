@@ -1,0 +1,311 @@
+//! [`PetscSolver`]: stamp's [`LinearSolver`] on PETSc, for `mpirun -n P`.
+//!
+//! What is distributed and what is not: every rank is handed the whole matrix (stamp's
+//! compressed-column tangent, assembled on every rank) and copies only its own contiguous range
+//! of rows into a distributed MPIAIJ matrix (rows split evenly by index), so the factorisation
+//! (MUMPS), the Krylov iterations and their memory are spread over the ranks while the model and
+//! its assembly are replicated. The solution is gathered onto every rank, so that every rank
+//! goes on with the same iterate; a hash of every right-hand side is compared over the ranks, so
+//! that ranks whose replicated states drifted apart stop with an error instead of waiting on each
+//! other.
+//!
+//! The default scheme is stamp's own (`LdltGmres`): restarted GMRES (40 vectors, at most 200
+//! iterations, preconditioned from the right so that it judges the true residual) on the tangent
+//! A, preconditioned by MUMPS's LDL^T factorisation of the symmetric matrix P the problem gives
+//! with A (PCCHOLESKY on an AIJ matrix: MUMPS's symmetric indefinite mode; the plate's P, see
+//! `Element::has_preconditioner`); without a P, MUMPS's LU of A itself. Options given to
+//! [`PetscSolver::with_options`] ("-ksp_type cg -pc_type gamg") are read after these defaults
+//! and override them; a near-null space ([`PetscSolver::set_near_null_space`], the rigid-body
+//! modes) is attached to P for algebraic multigrid. The pattern is analysed once: a matrix of the
+//! same pattern only refills the values, and PETSc keeps MUMPS's symbolic factorisation.
+//!
+//! Every failure is agreed over the ranks ([`Petsc::agree`]): a solve that fails on one rank
+//! fails on all, with the same message.
+
+use crate::error::PetscError;
+use crate::ksp::Ksp;
+use crate::matrix::{AijMatrix, RowPattern};
+use crate::petsc::{pint, Petsc};
+use crate::vector::{DVec, Gather};
+use faer::sparse::SparseColMatRef;
+use stamp::error::{Result, StampError};
+use stamp::linalg::linear_solver::{LinearSolver, SolverTimings};
+use std::time::Instant;
+
+/// Relative residual of a full-accuracy solve, and the floor of an inexact one.
+pub const RTOL: f64 = 1e-12;
+/// Most Krylov iterations of one solve.
+pub const MAX_ITERATIONS: usize = 200;
+/// Krylov vectors kept before GMRES restarts.
+pub const GMRES_RESTART: usize = 40;
+
+/// The distributed matrices and solver of one pattern.
+struct Setup {
+    /// (rows, entries, hash of the pattern) it was built for.
+    key: (usize, usize, u64),
+    /// Position in the compressed-column value array of each entry of this rank's rows.
+    src: Vec<usize>,
+    values: Vec<f64>,
+    a: AijMatrix,
+    p: Option<AijMatrix>,
+    ksp: Ksp,
+    b: DVec,
+    x: DVec,
+    gather: Gather,
+    /// (rtol, atol, most iterations) after the user's options: a solve to a looser tolerance
+    /// raises rtol, never lowers it below this one.
+    tolerances: (f64, f64, usize),
+}
+
+/// stamp's linear solver on PETSc (see the module documentation).
+pub struct PetscSolver {
+    petsc: Petsc,
+    options: String,
+    setup: Option<Setup>,
+    factored: bool,
+    /// Full-length vectors (one entry per equation) spanning the near-null space.
+    near_null: Vec<Vec<f64>>,
+    timings: SolverTimings,
+    iterations: usize,
+}
+
+impl PetscSolver {
+    /// The default scheme on PETSc, which must be initialised (every rank the same).
+    pub fn new(petsc: &Petsc) -> Self {
+        PetscSolver { petsc: petsc.clone(), options: String::new(), setup: None, factored: false, near_null: Vec::new(), timings: SolverTimings::default(), iterations: 0 }
+    }
+
+    /// The default scheme with PETSc options on top ("-ksp_type cg -pc_type gamg"), inserted into
+    /// PETSc's options database now (an option PETSc cannot parse is an error).
+    pub fn with_options(petsc: &Petsc, options: &str) -> Result<Self> {
+        petsc.insert_options(options).map_err(|e| StampError::LinearSolver(format!("petsc_options {options:?}: {}", e.message)))?;
+        Ok(PetscSolver { options: options.to_string(), ..Self::new(petsc) })
+    }
+
+    /// The options given to [`PetscSolver::with_options`].
+    pub fn options(&self) -> &str {
+        &self.options
+    }
+
+    /// Vectors spanning the near-null space of the matrices to come (one entry per equation,
+    /// every rank the same): the rigid-body modes of an elastic body, from which algebraic
+    /// multigrid (`-pc_type gamg`) builds its coarse spaces. Taken at the next new pattern.
+    pub fn set_near_null_space(&mut self, vectors: Vec<Vec<f64>>) {
+        self.near_null = vectors;
+        self.setup = None;
+        self.factored = false;
+    }
+
+    /// "gmres + cholesky (mumps)": the method and preconditioner in use (once set up), else the
+    /// default's name.
+    pub fn describe(&self) -> String {
+        match &self.setup {
+            Some(s) => s.ksp.describe(),
+            None => "gmres + cholesky (mumps)".into(),
+        }
+    }
+
+    /// Krylov iterations of all solves so far.
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+
+    pub fn petsc(&self) -> &Petsc {
+        &self.petsc
+    }
+
+    /// The same on every rank: Ok, or the error of the lowest failing rank.
+    fn agree<T>(&self, local: std::result::Result<T, PetscError>) -> Result<T> {
+        self.petsc.agree(local).map_err(StampError::LinearSolver)
+    }
+
+    /// This rank's rows of an n-row matrix: an even split by index.
+    fn rows(&self, n: usize) -> (usize, usize) {
+        let (r, p) = (self.petsc.rank(), self.petsc.size());
+        (n * r / p, n * (r + 1) / p)
+    }
+
+    /// Build the distributed matrices and the solver for the pattern of `a`.
+    fn analyse(&mut self, a: SparseColMatRef<'_, usize, f64>, with_p: bool, key: (usize, usize, u64)) -> std::result::Result<Setup, PetscError> {
+        let n = a.nrows();
+        let (lo, hi) = self.rows(n);
+        let sym = a.symbolic();
+        let (cp, ri) = (sym.col_ptr(), sym.row_idx());
+        // this rank's rows, compressed by rows: the transpose of the columns' entries in lo..hi
+        let mut count = vec![0usize; hi - lo + 1];
+        for &i in ri {
+            if (lo..hi).contains(&i) {
+                count[i - lo + 1] += 1;
+            }
+        }
+        for k in 0..hi - lo {
+            count[k + 1] += count[k];
+        }
+        let row_ptr = count.clone();
+        let mut fill = count;
+        let nnz = row_ptr[hi - lo];
+        let mut cols = vec![0; nnz];
+        let mut src = vec![0usize; nnz];
+        for j in 0..n {
+            for p in cp[j]..cp[j + 1] {
+                let i = ri[p];
+                if (lo..hi).contains(&i) {
+                    let slot = fill[i - lo];
+                    cols[slot] = pint(j)?;
+                    src[slot] = p;
+                    fill[i - lo] += 1;
+                }
+            }
+        }
+        let pattern = RowPattern { lo, hi, n, row_ptr, cols };
+        let am = AijMatrix::new(&self.petsc, pattern.clone())?;
+        let mut pm = if with_p {
+            let mut pm = AijMatrix::new(&self.petsc, pattern)?;
+            pm.set_symmetric(false)?;
+            Some(pm)
+        } else {
+            None
+        };
+        if !self.near_null.is_empty() {
+            if let Some(bad) = self.near_null.iter().find(|v| v.len() != n) {
+                return Err(PetscError::new(format!("a near-null vector has {} entries for a matrix of {n} rows", bad.len())));
+            }
+            let local: Vec<Vec<f64>> = self.near_null.iter().map(|v| v[lo..hi].to_vec()).collect();
+            match pm.as_mut() {
+                Some(pm) => pm.set_near_null_space(&self.petsc, &local)?,
+                None => {
+                    // the preconditioner is built from A
+                    let mut am = am;
+                    am.set_near_null_space(&self.petsc, &local)?;
+                    return self.finish(am, None, src, key, n, lo, hi);
+                }
+            }
+        }
+        self.finish(am, pm, src, key, n, lo, hi)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn finish(&self, a: AijMatrix, p: Option<AijMatrix>, src: Vec<usize>, key: (usize, usize, u64), n: usize, lo: usize, hi: usize) -> std::result::Result<Setup, PetscError> {
+        let mut ksp = Ksp::new(&self.petsc)?;
+        ksp.set_operators(&a, p.as_ref().unwrap_or(&a))?;
+        ksp.set_type("gmres")?;
+        ksp.set_gmres_restart(GMRES_RESTART)?;
+        ksp.set_tolerances(RTOL, 0.0, MAX_ITERATIONS)?;
+        ksp.set_pc_type(if p.is_some() { "cholesky" } else { "lu" })?;
+        ksp.set_factor_solver("mumps")?;
+        ksp.set_from_options()?;
+        // GMRES (the default, unless the options chose another method) is preconditioned from the
+        // right, so that it judges the true residual; CG and others keep PETSc's side
+        if ksp.ksp_type() == "gmres" && !self.options.contains("-ksp_pc_side") {
+            ksp.set_right_preconditioning()?;
+        }
+        let tolerances = ksp.tolerances()?;
+        let b = DVec::new(&self.petsc, hi - lo, n)?;
+        let x = DVec::new(&self.petsc, hi - lo, n)?;
+        let gather = Gather::new(&self.petsc, &x)?;
+        let values = vec![0.0; src.len()];
+        Ok(Setup { key, src, values, a, p, ksp, b, x, gather, tolerances })
+    }
+
+    fn factorize_local(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> std::result::Result<(), PetscError> {
+        if a.nrows() != a.ncols() {
+            return Err(PetscError::new(format!("a {} x {} matrix is not square", a.nrows(), a.ncols())));
+        }
+        if let Some(p) = p {
+            if !stamp::linalg::sparse::same_pattern(p.symbolic(), a.symbolic()) {
+                return Err(PetscError::new("the preconditioner's pattern is not the matrix's"));
+            }
+        }
+        let key = (a.nrows(), a.symbolic().row_idx().len(), pattern_hash(a));
+        let rebuild = match &self.setup {
+            Some(s) => s.key != key || s.p.is_some() != p.is_some(),
+            None => true,
+        };
+        if rebuild {
+            let t = Instant::now();
+            self.setup = None;
+            self.setup = Some(self.analyse(a, p.is_some(), key)?);
+            self.timings.symbolic += t.elapsed().as_secs_f64();
+        }
+        let t = Instant::now();
+        let s = self.setup.as_mut().unwrap();
+        let fill = |values: &mut Vec<f64>, src: &[usize], from: &[f64]| values.iter_mut().zip(src).for_each(|(v, &k)| *v = from[k]);
+        fill(&mut s.values, &s.src, a.val());
+        s.a.set_values(&s.values)?;
+        if let (Some(pm), Some(p)) = (s.p.as_mut(), p) {
+            fill(&mut s.values, &s.src, p.val());
+            pm.set_values(&s.values)?;
+        }
+        // the same matrices again: PETSc rebuilds the preconditioner, keeping its symbolic phase
+        s.ksp.set_operators(&s.a, s.p.as_ref().unwrap_or(&s.a))?;
+        s.ksp.set_up()?;
+        self.timings.factorization += t.elapsed().as_secs_f64();
+        self.timings.factorizations += 1;
+        Ok(())
+    }
+
+    fn solve_local(&mut self, b: &mut [f64], rtol: f64) -> std::result::Result<(), PetscError> {
+        // the replicated right-hand side must be the same on every rank, bit for bit
+        let h = b.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, x| (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3));
+        let (mut hi, mut lo) = ([h], [h]);
+        self.petsc.max_u64(&mut hi)?;
+        self.petsc.min_u64(&mut lo)?;
+        if hi != lo {
+            return Err(PetscError::new("the ranks hold different right-hand sides: their replicated states drifted apart"));
+        }
+        let s = self.setup.as_mut().ok_or_else(|| PetscError::new("solve called without a successful factorisation"))?;
+        if b.len() != s.key.0 {
+            return Err(PetscError::new(format!("a right-hand side of {} entries for a matrix of {} rows", b.len(), s.key.0)));
+        }
+        let t = Instant::now();
+        let (base, atol, max_it) = s.tolerances;
+        s.ksp.set_tolerances(rtol.max(base), atol, max_it)?;
+        s.b.set_from_full(b)?;
+        let report = s.ksp.solve(&s.b, &mut s.x)?;
+        s.gather.gather(&s.x, b)?;
+        self.iterations += report.iterations;
+        self.timings.solve += t.elapsed().as_secs_f64();
+        self.timings.solves += 1;
+        if b.iter().any(|x| !x.is_finite()) {
+            return Err(PetscError::new("the solution has non-finite entries: the matrix is singular"));
+        }
+        Ok(())
+    }
+}
+
+/// A hash of a compressed-column pattern (its column offsets and row indices).
+fn pattern_hash(a: SparseColMatRef<'_, usize, f64>) -> u64 {
+    let sym = a.symbolic();
+    sym.col_ptr().iter().chain(sym.row_idx()).fold(0xcbf2_9ce4_8422_2325u64, |h, &x| (h ^ x as u64).wrapping_mul(0x0100_0000_01b3))
+}
+
+impl LinearSolver for PetscSolver {
+    fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
+        self.factorize_preconditioned(a, None)
+    }
+
+    fn factorize_preconditioned(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> Result<()> {
+        self.factored = false;
+        let r = self.factorize_local(a, p);
+        self.agree(r)?;
+        self.factored = true;
+        Ok(())
+    }
+
+    fn uses_preconditioner(&self) -> bool {
+        true
+    }
+
+    fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()> {
+        self.solve_in_place_to(b, RTOL)
+    }
+
+    fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
+        let r = if self.factored { self.solve_local(b, rtol) } else { Err(PetscError::new("solve called without a successful factorisation")) };
+        self.agree(r)
+    }
+
+    fn timings(&self) -> SolverTimings {
+        self.timings
+    }
+}
