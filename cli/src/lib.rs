@@ -2,6 +2,8 @@
 //! `stamp check` around the problem-file library [`stamp_problem`].
 pub mod bench;
 pub mod commands;
+#[cfg(feature = "petsc")]
+pub mod mpi;
 pub mod paper;
 /// The problem-file layer, under the name it had when it lived in this crate.
 pub use stamp_problem as run;

@@ -95,10 +95,23 @@ fn main() -> ExitCode {
         }
         Err(e) => e.exit(),
     };
+    // `mpirun -n P stamp ...`: PETSc and MPI for the whole command (see mpi.rs)
+    #[cfg(feature = "petsc")]
+    let session = match stamp_cli::mpi::Session::start() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    #[cfg(feature = "petsc")]
+    let out_dir = |out: Option<PathBuf>| session.out_dir(out.as_deref()).map(std::path::Path::to_path_buf);
+    #[cfg(not(feature = "petsc"))]
+    let out_dir = |out: Option<PathBuf>| out;
     let result = match cli.command {
         None => stamp_cli::paper::paper_command(false, None),
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
-        Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::commands::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
+        Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::commands::run_command(&problem, out_dir(out).as_deref(), quiet, refine.map(usize::from)),
         Some(Command::Check { problem }) => stamp_cli::commands::check_command(&problem),
         Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, predictor, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor }),
         Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, predictor, one: None }) => {
@@ -109,6 +122,10 @@ fn main() -> ExitCode {
     // a reader that closed stdout early is no error; a stdout that cannot be written (a full disk,
     // /dev/full) is, once the command has done the rest of its work
     let stdout = stamp_cli::stdout::finish();
+    let result = result.map_err(|e| e.to_string());
+    // every rank ends with the same outcome
+    #[cfg(feature = "petsc")]
+    let result = session.finish(result);
     match (result, stdout) {
         (Ok(()), Ok(())) => ExitCode::SUCCESS,
         (Ok(()), Err(e)) => {

@@ -1,6 +1,6 @@
 //! PETSc's error codes as Rust errors with PETSc's message.
 //!
-//! [`crate::Petsc::initialize`] pushes [`handler`] as PETSc's error handler: instead of printing a
+//! [`crate::Petsc::initialize`] pushes `handler` as PETSc's error handler: instead of printing a
 //! traceback it keeps the message of the error where it arose (`PETSC_ERROR_INITIAL`, with the
 //! function, file and line), and PETSc returns the code up the stack. [`check`] turns a nonzero
 //! code into a [`PetscError`] with that message (or PETSc's text for the code when none was kept).

@@ -14,4 +14,5 @@ extern "C" {
     pub fn stamp_petsc_bcast_bytes(buf: *mut std::ffi::c_void, n: i32, root: i32) -> i32;
     pub fn stamp_petsc_barrier() -> i32;
     pub fn stamp_petsc_abort(code: i32) -> i32;
+    pub fn stamp_petsc_barrier_within(seconds: f64, done: *mut i32) -> i32;
 }

@@ -16,6 +16,9 @@
 //! destroyed. PETSc is not thread-safe: the objects are `Send` (moved to another thread as a
 //! whole) but not `Sync`, and PETSc calls are collective: every rank makes them in the same order.
 
+#[cfg(all(petsc_missing, not(doc)))]
+compile_error!("stamp-petsc: PETSc was not found (see the build script's warning): install libpetsc-real-dev, openmpi-bin, libopenmpi-dev, libclang-dev and pkg-config, or set PETSC_DIR and PETSC_ARCH");
+
 pub mod error;
 pub mod ffi;
 pub mod ksp;

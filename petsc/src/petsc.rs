@@ -63,6 +63,14 @@ impl Petsc {
         Ok(Petsc { inner })
     }
 
+    /// The live handle, if PETSc is initialised and not finalised (without initialising it).
+    pub fn current() -> Option<Petsc> {
+        match &*STATE.lock().ok()? {
+            State::Live(w) => w.upgrade().map(|inner| Petsc { inner }),
+            _ => None,
+        }
+    }
+
     /// This process's rank in PETSC_COMM_WORLD.
     pub fn rank(&self) -> usize {
         self.inner.rank
@@ -126,6 +134,15 @@ impl Petsc {
         check_mpi(unsafe { ffi::stamp_petsc_barrier() }, "MPI_Barrier")
     }
 
+    /// Wait for every rank (collective), at most `seconds` (None: for ever); false on time-out:
+    /// some rank did not come (it is busy in, or waiting at, another collective call), and the
+    /// caller should [`abort`](Petsc::abort) rather than make another collective call.
+    pub fn barrier_within(&self, seconds: Option<f64>) -> Result<bool> {
+        let mut done = 0;
+        check_mpi(unsafe { ffi::stamp_petsc_barrier_within(seconds.unwrap_or(-1.0), &mut done) }, "MPI_Ibarrier")?;
+        Ok(done != 0)
+    }
+
     /// Make every rank's outcome the same (collective): Ok on every rank if it was Ok on every
     /// rank, else on every rank the error of the lowest-numbered rank that failed, its message
     /// prefixed "rank r of P: " when not every rank failed. Each rank's own value is kept when all
@@ -159,9 +176,15 @@ impl Petsc {
     /// End every rank of the job now (MPI_Abort), with `code`: for a failure that the other ranks
     /// cannot be told of in a collective call.
     pub fn abort(&self, code: i32) -> ! {
-        unsafe { ffi::stamp_petsc_abort(code) };
-        std::process::exit(code)
+        abort_world(code)
     }
+}
+
+/// End every rank of the job now (MPI_Abort on PETSC_COMM_WORLD), without a handle (in a panic
+/// hook, say, which must not keep PETSc alive).
+pub fn abort_world(code: i32) -> ! {
+    unsafe { ffi::stamp_petsc_abort(code) };
+    std::process::exit(code)
 }
 
 /// A length as MPI's int.

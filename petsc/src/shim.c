@@ -2,6 +2,7 @@
  * are macros whose expansion differs between MPI implementations, so they are used here, in C,
  * rather than through bindgen. Each returns MPI's error code (MPI_SUCCESS = 0). */
 #include <petscsys.h>
+#include <time.h>
 
 int stamp_petsc_world_rank(int *rank) { return MPI_Comm_rank(PETSC_COMM_WORLD, rank); }
 
@@ -24,3 +25,23 @@ int stamp_petsc_bcast_bytes(void *buf, int n, int root) { return MPI_Bcast(buf, 
 int stamp_petsc_barrier(void) { return MPI_Barrier(PETSC_COMM_WORLD); }
 
 int stamp_petsc_abort(int code) { return MPI_Abort(PETSC_COMM_WORLD, code); }
+
+/* A barrier that gives up after `seconds` (< 0: waits for ever): *done = 1 when every rank
+ * arrived, 0 on time-out (the request is then left pending: the caller aborts). */
+int stamp_petsc_barrier_within(double seconds, int *done) {
+  MPI_Request req;
+  int flag = 0, rc = MPI_Ibarrier(PETSC_COMM_WORLD, &req);
+  if (rc != MPI_SUCCESS) return rc;
+  double start = MPI_Wtime();
+  while (!flag) {
+    rc = MPI_Test(&req, &flag, MPI_STATUS_IGNORE);
+    if (rc != MPI_SUCCESS) return rc;
+    if (!flag) {
+      if (seconds >= 0 && MPI_Wtime() - start > seconds) break;
+      struct timespec ts = {0, 1000000};
+      nanosleep(&ts, NULL);
+    }
+  }
+  *done = flag;
+  return MPI_SUCCESS;
+}

@@ -142,6 +142,7 @@ pub fn mesh_error(p: &Problem, mesh: &MeshData, e: StampError) -> StampError {
 /// Build everything the solve needs.
 pub fn build(p: &Problem) -> Result<Setup> {
     let s = &p.spec;
+    super::parallel::check_options(p)?;
     let mesh = MeshData::load(p).map_err(|e| match e {
         StampError::Mesh(m) => p.error_at(s.mesh.span(), "mesh", m),
         e => e,

@@ -34,6 +34,7 @@ pub mod mesh;
 pub mod out_dir;
 pub mod output;
 pub mod own_inputs;
+pub mod parallel;
 pub mod plate_model;
 pub mod plot;
 pub mod pressure;

@@ -861,6 +861,10 @@ pub struct SolverSpec {
     /// Where each load step starts (default "secant").
     #[serde(default)]
     pub predictor: Option<Spanned<Predictor>>,
+    /// PETSc options for the linear solve ("-ksp_type cg -pc_type gamg"), for a stamp built with
+    /// the feature `petsc` (see crate::parallel).
+    #[serde(default)]
+    pub petsc_options: Option<Spanned<String>>,
 }
 
 /// `[solver] predictor`: the start of each load step.

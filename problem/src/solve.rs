@@ -87,6 +87,10 @@ struct PunchMeta {
 
 #[derive(Serialize)]
 struct Summary {
+    /// The processes the run solved on (`mpirun -n P`; 1 without MPI).
+    ranks: usize,
+    /// The linear solver of the Newton iterations (see parallel.rs).
+    linear_solver: String,
     problem: String,
     title: Option<String>,
     /// "running" while the solve goes on, then "converged" or "failed" (any error, a failed write
@@ -349,7 +353,17 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut probes = Probes::new(p, &mesh, &out.probe, &punch_names)?;
     let thickness_probes = super::thickness_probe::ThicknessProbes::new(p, &mesh)?;
 
+    // the linear solver (PETSc's under the feature `petsc`, see parallel.rs)
+    let ranks = super::parallel::ranks();
+    let linear = {
+        let layout = Layout::of(&model.element);
+        let z = |c: usize| section.delta_minus + (layout.zeta_of_component(c) + 1.0) / 2.0 * section.thickness();
+        let inner = model.num_equations() - model.num_drives();
+        super::parallel::linear_solver(p, &mesh.mesh.coords, model.dofs.equations(), model.dofs.dofs_per_node(), inner, z)?
+    };
     let mut summary = Summary {
+        ranks,
+        linear_solver: super::parallel::describe(&linear),
         problem: p.path.display().to_string(),
         title: p.spec.title.clone(),
         status: "running".into(),
@@ -423,7 +437,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
     // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
-    let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
+    let mut newton = NewtonRaphson::new(BorderedSolver::with_inner(model.num_drives(), linear), settings);
     if let Some(previous) = &opts.previous {
         super::coarse::predict_from(&mut newton, previous.path_onto(&mesh.mesh, model.dofs.dofs_per_node()));
     } else if let Some(coarse) = coarse {
@@ -461,7 +475,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut u_prev = u.clone();
     let layout = Layout::of(&model.element);
     let size = mesh.mesh.coords.iter().flat_map(|x| x.iter()).fold(section.thickness(), |m, v| m.max(v.abs()));
-    let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
+    let mut each_step = |rep: &stamp::nonlinear::StepReport, u: &[f64], m: &stamp::model::Model<super::plate_model::Plate>| {
         total_iterations += rep.iterations;
         total_failed += rep.failed_iterations;
         if opts.record_states {
@@ -573,6 +587,13 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
                 stop.store(true, std::sync::atomic::Ordering::Relaxed);
             }
         }
+    };
+    let result = newton.solve_path(&mut model, &mut u, 0.0, &targets, &mut |rep, u, m| {
+        each_step(rep, u, m);
+        // under MPI the outputs are rank 0's: a failed write there stops every rank after this step
+        if ranks > 1 {
+            stop.store(super::parallel::any_rank(stop.load(std::sync::atomic::Ordering::Relaxed)), std::sync::atomic::Ordering::Relaxed);
+        }
     });
     progress.finish();
     drop(cx);
@@ -622,6 +643,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         crate::out!("{}", super::table::render(&history, &units));
     }
     summary.seconds = start.elapsed().as_secs_f64();
+    summary.linear_solver = super::parallel::describe(newton.linear.inner());
     match &failure {
         None if opts.caller_finishes => {}
         None => summary.status = "converged".into(),

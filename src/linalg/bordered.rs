@@ -78,6 +78,11 @@ impl<S: LinearSolver> BorderedSolver<S> {
         }
     }
 
+    /// The solver of the leading block.
+    pub fn inner(&self) -> &S {
+        &self.inner
+    }
+
     fn build_maps(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
         let n = a.ncols();
         let m = self.border;

@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""Compare two history.csv files column by column: the same header, the same steps, and every
+value within TOL relative to its column's scale, |a - b| <= TOL * scale, the scale being the
+largest magnitude in the column (both files) and, for the displacement columns (names ending
+_u1, _u2, _u3), the largest displacement of any of them: a displacement that is zero by symmetry
+holds round-off (1e-17) and is judged on the size of the displacements, not on its own noise.
+Prints the worst column; exit 1 on a difference."""
+import csv
+import sys
+
+TOL = 1e-8
+
+
+def read(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+def main(ref_path, new_path, tol=TOL):
+    h1, r1 = read(ref_path)
+    h2, r2 = read(new_path)
+    if h1 != h2:
+        print(f"{new_path}: header differs from {ref_path}:\n  {h1}\n  {h2}")
+        return 1
+    if len(r1) != len(r2):
+        print(f"{new_path}: {len(r2)} steps, {ref_path}: {len(r1)}")
+        return 1
+    def numbers(c):
+        try:
+            return [float(r[c]) for r in r1 + r2]
+        except ValueError:
+            return []
+
+    displacement = [c for c, name in enumerate(h1) if name.endswith(("_u1", "_u2", "_u3"))]
+    u_scale = max([abs(x) for c in displacement for x in numbers(c)] + [0.0])
+    worst = (0.0, "", 0)
+    for c, name in enumerate(h1):
+        try:
+            a = [float(r[c]) for r in r1]
+            b = [float(r[c]) for r in r2]
+        except ValueError:
+            if [r[c] for r in r1] != [r[c] for r in r2]:
+                print(f"{new_path}: column {name} differs")
+                return 1
+            continue
+        scale = u_scale if c in displacement else max([abs(x) for x in a + b] + [0.0])
+        for k, (x, y) in enumerate(zip(a, b)):
+            d = abs(x - y) / scale if scale > 0 else 0.0
+            if d > worst[0]:
+                worst = (d, name, k + 1)
+    d, name, row = worst
+    status = "ok" if d <= tol else "DIFFERS"
+    print(f"{status}: {new_path} against {ref_path}: largest difference {d:.2e} of its column's scale ({name}, row {row}; tolerance {tol:.0e})")
+    return 0 if d <= tol else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1], sys.argv[2]))

@@ -1,0 +1,96 @@
+//! `mpirun -n P stamp ...` (the feature `petsc`): PETSc and MPI for the whole command, and the
+//! rules that make P processes behave as one program.
+//!
+//! - PETSc is initialised at the start and finalised at the end ([`Session`]).
+//! - With P > 1 each rank runs its rayon work on one thread: the ranks are the parallelism, and
+//!   the replicated computation (stamp_problem::parallel) must give every rank the same numbers to
+//!   the bit, which a reduction over a varying number of threads would not.
+//! - Rank 0 writes the outputs and prints; the other ranks run the same code into a scratch folder
+//!   of their own (removed at the end) with stdout and stderr on /dev/null, so that every rank
+//!   makes the same collective calls in the same order.
+//! - The outcome is agreed at the end: every rank exits with the error of the lowest rank that
+//!   failed, printed once by rank 0. A rank that failed and finds the others still busy after
+//!   [`ALONE_AFTER`] seconds (it failed alone, before the solve: its output folder could not be
+//!   made, say, while the others wait for it in a collective call) prints its message and ends
+//!   every rank (MPI_Abort); so does a panic on any rank. Failures during the solve are agreed
+//!   where they happen (stamp_petsc::PetscSolver, and a failed write stops every rank after its
+//!   step: stamp_problem::parallel::any_rank), so they end here together.
+
+use stamp_petsc::Petsc;
+use std::path::{Path, PathBuf};
+
+/// Seconds a rank that failed waits for the others at the end before it ends the job.
+pub const ALONE_AFTER: f64 = 20.0;
+
+/// PETSc for the life of the command.
+pub struct Session {
+    petsc: Petsc,
+    scratch: Option<PathBuf>,
+    /// The original stderr (rank > 0 prints nothing else).
+    stderr: i32,
+}
+
+impl Session {
+    /// Initialise PETSc and MPI, and set the rules above.
+    pub fn start() -> Result<Session, String> {
+        let petsc = Petsc::initialize().map_err(|e| format!("cannot start PETSc and MPI: {e}"))?;
+        let (rank, size) = (petsc.rank(), petsc.size());
+        let mut scratch = None;
+        let mut stderr = 2;
+        if size > 1 {
+            let _ = rayon::ThreadPoolBuilder::new().num_threads(1).build_global();
+            // the original stderr, for a panic's message
+            let err = unsafe { libc::dup(2) };
+            stderr = err;
+            if rank > 0 {
+                let null = std::fs::OpenOptions::new().write(true).open("/dev/null").map_err(|e| format!("/dev/null: {e}"))?;
+                use std::os::fd::AsRawFd;
+                unsafe {
+                    libc::dup2(null.as_raw_fd(), 1);
+                    libc::dup2(null.as_raw_fd(), 2);
+                }
+                scratch = Some(std::env::temp_dir().join(format!("stamp-rank{rank}-{}", std::process::id())));
+            }
+            std::panic::set_hook(Box::new(move |info| {
+                let text = format!("error: rank {rank} of {size} panicked: {info}\n");
+                unsafe { libc::write(err, text.as_ptr().cast(), text.len()) };
+                stamp_petsc::petsc::abort_world(101);
+            }));
+        }
+        Ok(Session { petsc, scratch, stderr })
+    }
+
+    /// The output folder of this rank: `out` on rank 0, a scratch folder of its own elsewhere.
+    pub fn out_dir<'a>(&'a self, out: Option<&'a Path>) -> Option<&'a Path> {
+        self.scratch.as_deref().or(out)
+    }
+
+    /// The command's outcome, the same on every rank (collective); the scratch folder removed.
+    pub fn finish(self, result: Result<(), String>) -> Result<(), String> {
+        let (rank, size) = (self.petsc.rank(), self.petsc.size());
+        let agreed = if size > 1 {
+            let wait = result.is_err().then_some(ALONE_AFTER);
+            match (self.petsc.barrier_within(wait), &result) {
+                (Ok(true), _) => self.petsc.agree(result),
+                (_, Err(e)) => {
+                    let text = format!("error: rank {rank} of {size}: {e}\n(the other ranks did not stop within {ALONE_AFTER} s: ending them)\n");
+                    unsafe { libc::write(self.stderr, text.as_ptr().cast(), text.len()) };
+                    if let Some(dir) = &self.scratch {
+                        let _ = std::fs::remove_dir_all(dir);
+                    }
+                    self.petsc.abort(1)
+                }
+                (Err(e), Ok(())) => Err(e.to_string()),
+                (Ok(false), Ok(())) => Err("the ranks did not meet at the end".into()),
+            }
+        } else {
+            result
+        };
+        // PetscFinalize follows when the handle is dropped, at the end of this function
+        let _ = std::panic::take_hook();
+        if let Some(dir) = &self.scratch {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+        agreed
+    }
+}

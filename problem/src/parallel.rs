@@ -1,0 +1,130 @@
+//! The linear solver of `stamp run`, and the processes it runs on.
+//!
+//! Built without the cargo feature `petsc` (the default): one process, stamp's own
+//! [`LdltGmres`] (faer). With it (`cargo build --release -p stamp-cli --features petsc`),
+//! `mpirun -n P stamp run PROBLEM.toml` runs on P processes, and the Newton linear solve of every
+//! run goes through PETSc (`stamp_petsc::PetscSolver`: by default GMRES on the tangent
+//! preconditioned by MUMPS's LDL^T of the plate's P, the scheme of [`LdltGmres`]; `[solver]
+//! petsc_options` on top, with the rigid-body modes as the near-null space for GAMG).
+//!
+//! What is distributed: the tangent, by rows, and its factorisation and solves. What is
+//! replicated: every rank reads the problem, builds the whole model and assembles the whole
+//! tangent and residual, and runs the same Newton iterations on the gathered solution; so the
+//! active sets, the augmented-Lagrangian updates, the line search and every convergence test are
+//! the same on every rank by construction (PetscSolver checks that the right-hand sides agree to
+//! the bit). A failure in the solve is agreed over the ranks; one in writing (rank 0 only) stops
+//! every rank after the step ([`any_rank`]).
+
+use crate::problem::Problem;
+use stamp::Result;
+
+/// The linear solver of the run's Newton iterations (inside the bordered solver of the
+/// force-driven punches).
+#[cfg(not(feature = "petsc"))]
+pub type Linear = stamp::linalg::ldlt_gmres::LdltGmres;
+#[cfg(feature = "petsc")]
+pub type Linear = stamp_petsc::PetscSolver;
+
+pub use stamp::linalg::ldlt_gmres::LdltGmres;
+
+/// The processes of the run: the size of PETSC_COMM_WORLD while PETSc is initialised (`stamp`
+/// initialises it at its start under the feature `petsc`), else 1.
+pub fn ranks() -> usize {
+    #[cfg(feature = "petsc")]
+    if let Some(p) = stamp_petsc::Petsc::current() {
+        return p.size();
+    }
+    1
+}
+
+/// This process's rank (0 without the feature).
+pub fn rank() -> usize {
+    #[cfg(feature = "petsc")]
+    if let Some(p) = stamp_petsc::Petsc::current() {
+        return p.rank();
+    }
+    0
+}
+
+/// True on every rank if `flag` is true on any (collective under MPI; `flag` itself otherwise).
+pub fn any_rank(flag: bool) -> bool {
+    #[cfg(feature = "petsc")]
+    if let Some(p) = stamp_petsc::Petsc::current() {
+        if p.size() > 1 {
+            let mut v = [flag as u64];
+            return p.max_u64(&mut v).map(|_| v[0] != 0).unwrap_or(true);
+        }
+    }
+    flag
+}
+
+/// `[solver] petsc_options` is for a stamp built with the feature `petsc`: an error at the key
+/// without it.
+pub fn check_options(p: &Problem) -> Result<()> {
+    let Some(opts) = &p.spec.solver.petsc_options else { return Ok(()) };
+    if cfg!(feature = "petsc") {
+        return Ok(());
+    }
+    Err(p.error_at(opts.span(), "solver.petsc_options", "PETSc options need a stamp built with PETSc: cargo build --release -p stamp-cli --features petsc"))
+}
+
+/// The linear solver for a model of `dofs_per_node` unknowns per node at `coords`, whose
+/// equations are numbered by `equations` (dof -> equation, PRESCRIBED for none), the first
+/// `inner` of them solved by the inner solver; `z_of_component(c)`: the height of the surface
+/// that unknown c of a node moves.
+pub fn linear_solver(p: &Problem, coords: &[[f64; 2]], equations: &[u32], dofs_per_node: usize, inner: usize, z_of_component: impl Fn(usize) -> f64) -> Result<Linear> {
+    #[cfg(not(feature = "petsc"))]
+    {
+        let _ = (p, coords, equations, dofs_per_node, inner, z_of_component);
+        Ok(LdltGmres::new())
+    }
+    #[cfg(feature = "petsc")]
+    {
+        let petsc = stamp_petsc::Petsc::initialize()?;
+        let options = p.spec.solver.petsc_options.as_ref().map(|o| o.get_ref().clone()).unwrap_or_default();
+        let mut solver = stamp_petsc::PetscSolver::with_options(&petsc, &options).map_err(|e| match &p.spec.solver.petsc_options {
+            Some(o) => p.error_at(o.span(), "solver.petsc_options", e.to_string()),
+            None => e,
+        })?;
+        solver.set_near_null_space(rigid_body_modes(coords, equations, dofs_per_node, inner, z_of_component));
+        Ok(solver)
+    }
+}
+
+/// The six rigid-body motions u(X) = a + w x (X - O) (O the centre of the nodes, rotations scaled
+/// by the model size) at the plate's unknowns, one entry per equation below `inner`: unknown c of
+/// a node is component c % 3 of the displacement of the surface at height `z_of_component(c)`.
+pub fn rigid_body_modes(coords: &[[f64; 2]], equations: &[u32], dofs_per_node: usize, inner: usize, z_of_component: impl Fn(usize) -> f64) -> Vec<Vec<f64>> {
+    let n = coords.len().max(1) as f64;
+    let o = [coords.iter().map(|x| x[0]).sum::<f64>() / n, coords.iter().map(|x| x[1]).sum::<f64>() / n];
+    let s = coords.iter().map(|x| (x[0] - o[0]).abs().max((x[1] - o[1]).abs())).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    let mut modes = vec![vec![0.0; inner]; 6];
+    for (dof, &eq) in equations.iter().enumerate() {
+        if eq == stamp::dofs::PRESCRIBED || eq as usize >= inner {
+            continue;
+        }
+        let (node, c) = (dof / dofs_per_node, dof % dofs_per_node);
+        let r = [(coords[node][0] - o[0]) / s, (coords[node][1] - o[1]) / s, z_of_component(c) / s];
+        let k = c % 3;
+        modes[k][eq as usize] = 1.0;
+        // w x r for w = e_x, e_y, e_z: component k
+        let cross = [[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]];
+        for w in 0..3 {
+            modes[3 + w][eq as usize] = cross[w][k];
+        }
+    }
+    modes
+}
+
+/// "LDL^T + GMRES (faer)" or PETSc's "gmres + cholesky (mumps)": the linear solver in use.
+pub fn describe(l: &Linear) -> String {
+    #[cfg(not(feature = "petsc"))]
+    {
+        let _ = l;
+        "faer: LDL^T of P, GMRES where the tangent is not symmetric".into()
+    }
+    #[cfg(feature = "petsc")]
+    {
+        format!("PETSc {}: {}", l.petsc().version(), l.describe())
+    }
+}
