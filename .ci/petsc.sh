@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# The PETSc back end (cargo feature `petsc`): installs PETSc and MPI, runs stamp-petsc's tests
+# (distributed solves on 1, 2 and 4 ranks), then the shipped examples with `mpirun -n P stamp run`
+# against the default (faer) run: every history.csv column within 1e-8 of its scale
+# (.ci/compare_history.py), all examples on 1 rank, the quicker ones on 2 and 4; and failing ranks
+# (a rank that fails alone, a Newton failure, a bad problem file): every rank ends, one message.
+# About 3-4 minutes on the 2-core machine after the default build (see the timing it prints).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+start=$SECONDS
+if ! pkg-config --exists PETSc 2>/dev/null || ! command -v mpirun >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/libclang*.so* >/dev/null 2>&1; then
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libpetsc-real-dev openmpi-bin libopenmpi-dev libclang-dev pkg-config >/dev/null
+fi
+export OMP_NUM_THREADS=1
+mpirun=(mpirun --oversubscribe)
+[ "$(id -u)" = 0 ] && mpirun+=(--allow-run-as-root)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+bad() { echo "FAILED: $*"; failed=$((failed + 1)); }
+
+# the reference: the default build
+cargo build --release -p stamp-cli
+cp target/release/stamp "$work/stamp-faer"
+cargo test --release -p stamp-petsc
+cargo build --release -p stamp-cli --features petsc
+stamp=target/release/stamp
+
+# sphere-clamped is compared at 1e-5: its first step converges with |R| at 5e-9 of the force
+# scale, and the peak pressure there differs by 1.2e-6 between the faer and the PETSc iterates
+quick="sphere-ss sphere-ss-displacement paper-r100 stl-die squeeze sphere-clamped ellipsoid-expression sphere-slide"
+for f in meshes/*.toml; do
+  name=$(basename "$f" .toml)
+  "$work/stamp-faer" run "$f" --out "$work/faer-$name" -q 2>/dev/null || { bad "$name: the faer run failed"; continue; }
+  tol=1e-8
+  [ "$name" = sphere-clamped ] && tol=1e-5
+  for ranks in 1 2 4; do
+    if [ "$ranks" != 1 ] && ! [[ " $quick " == *" $name "* ]]; then continue; fi
+    out="$work/p$ranks-$name"
+    if ! timeout 300 "${mpirun[@]}" -n "$ranks" "$stamp" run "$f" --out "$out" -q 2>"$out.err"; then
+      bad "$name on $ranks ranks: $(tail -3 "$out.err")"
+      continue
+    fi
+    if python3 .ci/compare_history.py "$work/faer-$name/history.csv" "$out/history.csv" "$tol" && \
+       python3 -c "import json,sys; s=json.load(open('$out/summary.json')); sys.exit(0 if s['ranks'] == $ranks and s['linear_solver'].startswith('PETSc') and s['status'] == 'converged' else 1)"; then
+      ok
+    else
+      bad "$name on $ranks ranks differs from the faer run, or its summary.json does not say ranks = $ranks and PETSc"
+    fi
+  done
+done
+
+# rank 0 alone cannot make its output folder: it ends every rank with its message
+t0=$SECONDS
+if timeout 120 "${mpirun[@]}" -n 2 "$stamp" run meshes/sphere-ss.toml --out /proc/stamp-cannot-write -q 2>"$work/alone.err"; then
+  bad "a rank that failed alone: the job succeeded"
+elif [ $? = 124 ]; then
+  bad "a rank that failed alone: the job hung"
+elif grep -q "^error: rank 0 of 2: /proc/stamp-cannot-write" "$work/alone.err"; then
+  echo "a rank that failed alone ended the job in $((SECONDS - t0)) s"; ok
+else
+  bad "a rank that failed alone: $(cat "$work/alone.err")"
+fi
+# a Newton failure on 2 ranks: one message, summary.json failed
+sed -e 's/^\[solver\]/[solver]\nmax_iterations = 2\nmax_cutbacks = 1/' -e "s|file = \"|file = \"$PWD/meshes/|" meshes/sphere-ss.toml >"$work/newton.toml"
+if timeout 120 "${mpirun[@]}" -n 2 "$stamp" run "$work/newton.toml" --out "$work/newton" -q 2>"$work/newton.err"; then
+  bad "a Newton failure on 2 ranks: the job succeeded"
+elif [ "$(grep -c '^error: Newton-Raphson did not converge' "$work/newton.err")" = 1 ] && \
+     python3 -c "import json,sys; s=json.load(open('$work/newton/summary.json')); sys.exit(0 if s['status'] == 'failed' and s['ranks'] == 2 else 1)"; then
+  ok
+else
+  bad "a Newton failure on 2 ranks: $(cat "$work/newton.err")"
+fi
+# a bad problem file on 4 ranks: one message
+printf '[mesh]\nrectangle = [1, 1]\nno_such_key = 3\n' >"$work/bad.toml"
+if timeout 120 "${mpirun[@]}" -n 4 "$stamp" run "$work/bad.toml" -q 2>"$work/bad.err"; then
+  bad "a bad problem file on 4 ranks: the job succeeded"
+elif [ "$(grep -c '^error: ' "$work/bad.err")" = 1 ] && grep -q "no_such_key" "$work/bad.err"; then
+  ok
+else
+  bad "a bad problem file on 4 ranks: $(cat "$work/bad.err")"
+fi
+
+echo "petsc: $((SECONDS - start)) s"
+echo "$passed passed, $failed failed"
+[ "$failed" = 0 ]
