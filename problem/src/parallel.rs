@@ -128,3 +128,60 @@ pub fn describe(l: &Linear) -> String {
         format!("PETSc {}: {}", l.petsc().version(), l.describe())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The six modes are the rigid motions a + w x (X - O) at each unknown's surface point, O the
+    /// centre of the nodes and lengths scaled by the largest distance from it; prescribed dofs
+    /// and the border (equations from `inner` on) are left out.
+    #[test]
+    fn rigid_body_modes_are_rigid_motions_at_the_surfaces() {
+        // two nodes, the paper's two surfaces (components 0-2 at z = -0.5, 3-5 at z = 0.5)
+        let coords = [[0.0, 0.0], [2.0, 0.0]];
+        let z = |c: usize| if c < 3 { -0.5 } else { 0.5 };
+        let p = stamp::dofs::PRESCRIBED;
+        // dof 2 (node 0, u3 of S-) prescribed; node 1's last dof is equation 10, beyond inner = 10
+        let equations: Vec<u32> = vec![0, 1, p, 2, 3, 4, 5, 6, 7, 8, 9, 10];
+        let modes = rigid_body_modes(&coords, &equations, 6, 10, z);
+        assert_eq!(modes.len(), 6);
+        assert!(modes.iter().all(|m| m.len() == 10));
+        // O = (1, 0), scale 1: node 0 at r = (-1, 0, z), node 1 at (1, 0, z)
+        for (dof, &eq) in equations.iter().enumerate() {
+            if eq == p || eq >= 10 {
+                continue;
+            }
+            let (node, c) = (dof / 6, dof % 6);
+            let r = [if node == 0 { -1.0 } else { 1.0 }, 0.0, z(c)];
+            let k = c % 3;
+            for t in 0..3 {
+                assert_eq!(modes[t][eq as usize], if t == k { 1.0 } else { 0.0 });
+            }
+            // w x r for the unit rotations about x, y, z
+            let rot = [[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]];
+            for w in 0..3 {
+                assert_eq!(modes[3 + w][eq as usize], rot[w][k], "dof {dof}, rotation {w}");
+            }
+        }
+        // a rotation about z moves node 1 along +x2 and node 0 along -x2
+        assert_eq!(modes[5][equations[7] as usize], 1.0);
+        assert_eq!(modes[5][equations[1] as usize], -1.0);
+    }
+
+    /// Without the feature `petsc`, `[solver] petsc_options` is an error at its line and key, not
+    /// an option silently ignored; with it, the problem builds.
+    #[test]
+    fn petsc_options_need_the_feature() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../meshes");
+        let source = std::fs::read_to_string(dir.join("sphere-ss.toml")).unwrap().replace("[solver]", "[solver]\npetsc_options = \"-pc_type gamg\"");
+        let p = Problem::parse(&dir.join("sphere-ss.toml"), source).unwrap();
+        let built = crate::build::build(&p);
+        if cfg!(feature = "petsc") {
+            assert!(built.is_ok());
+        } else {
+            let e = built.err().expect("petsc_options refused").to_string();
+            assert!(e.contains("solver.petsc_options") && e.contains("--features petsc") && e.contains("line "), "{e}");
+        }
+    }
+}
