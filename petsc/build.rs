@@ -63,6 +63,7 @@ const FUNCTIONS: &[&str] = &[
     "PCGetType",
     "PCFactorSetMatSolverType",
     "PCFactorGetMatSolverType",
+    "PCGetFailedReason",
 ];
 
 /// The binding's types, for documentation without PETSc.
@@ -171,6 +172,7 @@ fn main() {
         .allowlist_type("MatOption")
         .allowlist_type("PCSide")
         .allowlist_type("KSPConvergedReason")
+        .allowlist_type("PCFailedReason")
         .default_enum_style(bindgen::EnumVariation::Consts)
         .layout_tests(false);
     for f in FUNCTIONS {

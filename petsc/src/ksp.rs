@@ -113,9 +113,31 @@ impl Ksp {
         if report.reason < 0 {
             let mut s = std::ptr::null();
             unsafe { ffi::KSPGetConvergedReasonString(self.raw, &mut s) };
-            return Err(PetscError { code: report.reason, message: format!("the {} solve did not converge: {} after {} iterations", self.describe(), string(s), its) });
+            let mut message = format!("the {} solve did not converge: {} after {} iterations", self.describe(), string(s), its);
+            if report.reason == ffi::KSPConvergedReason_KSP_DIVERGED_PC_FAILED as i32 {
+                message.push_str(&format!(" (the preconditioner: {})", self.pc_failure()));
+            }
+            return Err(PetscError { code: report.reason, message });
         }
         Ok(report)
+    }
+
+    /// Why the preconditioner failed on this rank, in PETSc's words and ours.
+    fn pc_failure(&self) -> String {
+        let mut r = ffi::PCFailedReason_PC_NOERROR;
+        if let Ok(pc) = self.pc() {
+            unsafe { ffi::PCGetFailedReason(pc, &mut r) };
+        }
+        match r {
+            ffi::PCFailedReason_PC_SETUP_ERROR => "SETUP_ERROR".into(),
+            ffi::PCFailedReason_PC_FACTOR_STRUCT_ZEROPIVOT => "FACTOR_STRUCT_ZEROPIVOT, a structurally zero pivot: the matrix is singular".into(),
+            ffi::PCFailedReason_PC_FACTOR_NUMERIC_ZEROPIVOT => "FACTOR_NUMERIC_ZEROPIVOT, a zero pivot in the factorisation: the matrix is singular".into(),
+            ffi::PCFailedReason_PC_FACTOR_OUTMEMORY => "FACTOR_OUTMEMORY, out of memory in the factorisation".into(),
+            ffi::PCFailedReason_PC_FACTOR_OTHER => "FACTOR_OTHER, the factorisation failed".into(),
+            ffi::PCFailedReason_PC_SUBPC_ERROR => "SUBPC_ERROR, an inner preconditioner failed".into(),
+            ffi::PCFailedReason_PC_NOERROR => "failed on another rank".into(),
+            other => format!("reason {other}"),
+        }
     }
 
     /// The Krylov method's name.
