@@ -97,7 +97,7 @@ fn main() -> ExitCode {
     };
     // `mpirun -n P stamp ...`: PETSc and MPI for the whole command (see mpi.rs)
     #[cfg(feature = "petsc")]
-    let session = match stamp_cli::mpi::Session::start() {
+    let mut session = match stamp_cli::mpi::Session::start() {
         Ok(s) => s,
         Err(e) => {
             eprintln!("error: {e}");
@@ -126,7 +126,7 @@ fn main() -> ExitCode {
     // every rank ends with the same outcome
     #[cfg(feature = "petsc")]
     let result = session.finish(result);
-    match (result, stdout) {
+    let code = match (result, stdout) {
         (Ok(()), Ok(())) => ExitCode::SUCCESS,
         (Ok(()), Err(e)) => {
             eprintln!("error: cannot write to stdout: {e}");
@@ -140,5 +140,8 @@ fn main() -> ExitCode {
                 None => ExitCode::FAILURE,
             }
         }
-    }
+    };
+    #[cfg(feature = "petsc")]
+    session.end();
+    code
 }

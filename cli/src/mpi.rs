@@ -66,7 +66,8 @@ impl Session {
     }
 
     /// The command's outcome, the same on every rank (collective); the scratch folder removed.
-    pub fn finish(self, result: Result<(), String>) -> Result<(), String> {
+    /// [`end`](Self::end) follows once rank 0 has printed it.
+    pub fn finish(&mut self, result: Result<(), String>) -> Result<(), String> {
         let (rank, size) = (self.petsc.rank(), self.petsc.size());
         let agreed = if size > 1 {
             let wait = result.is_err().then_some(ALONE_AFTER);
@@ -86,11 +87,19 @@ impl Session {
         } else {
             result
         };
-        // PetscFinalize follows when the handle is dropped, at the end of this function
-        let _ = std::panic::take_hook();
         if let Some(dir) = &self.scratch {
             let _ = std::fs::remove_dir_all(dir);
         }
         agreed
+    }
+
+    /// The end of the command, after rank 0 printed its outcome: every rank waits for the others
+    /// here, so that no rank exits (and mpirun, seeing its failure status, kills the job) before
+    /// rank 0's message is out; then PETSc is finalised (the handle dropped).
+    pub fn end(self) {
+        if self.petsc.size() > 1 {
+            let _ = self.petsc.barrier();
+        }
+        let _ = std::panic::take_hook();
     }
 }

@@ -153,20 +153,8 @@ pub struct Layerwise {
     bounds: Vec<f64>,
 }
 
-/// Lagrange functions of the nodes `zs` and their derivatives at `z`.
-fn lagrange(zs: &[f64], z: f64) -> (Vec<f64>, Vec<f64>) {
-    let n = zs.len();
-    let mut l = vec![1.0; n];
-    let mut dl = vec![0.0; n];
-    for s in 0..n {
-        for k in (0..n).filter(|&k| k != s) {
-            let d = zs[s] - zs[k];
-            dl[s] = dl[s] * (z - zs[k]) / d + l[s] / d;
-            l[s] *= (z - zs[k]) / d;
-        }
-    }
-    (l, dl)
-}
+// Lagrange functions of the nodes `zs` and their derivatives at `z`: the element's own
+use stamp_elements::multi_surface::lagrange;
 
 /// The n-point Gauss rule on [-1, 1] (Golub-Welsch: the eigenvalues of the Jacobi matrix).
 fn gauss(n: usize) -> Vec<(f64, f64)> {
