@@ -144,7 +144,7 @@ pub fn strain_rotation(theta: f64) -> Stiffness {
 }
 
 /// The stiffness `c` of a material whose axes lie at `theta` (radians, from axis 1 towards axis 2)
-/// of the frame it is wanted in: C = T^T C' T with T = [`strain_rotation`](theta), from the energy
+/// of the frame it is wanted in: C = T^T C' T with T = [`strain_rotation`]\(theta\), from the energy
 /// E'.C'E' / 2 = E.(T^T C' T)E / 2.
 pub fn rotate(c: &Stiffness, theta: f64) -> Stiffness {
     let t = strain_rotation(theta);
