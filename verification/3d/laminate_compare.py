@@ -38,6 +38,8 @@ def extrapolate(ls, fs):
             else:
                 lo = mid
         p = 0.5 * (lo + hi)
+    if not 0.5 < p < 6.0:
+        return None, p  # no clean power law: no extrapolation
     c = d2 / (l2 ** p - l3 ** p)
     return f3 - c * l3 ** p, p
 
@@ -73,17 +75,23 @@ def main():
     for k, t in enumerate(travels):
         gf = [r["steps"][k]["force"] for r in g]
         gl = [20.0 / r["n"] for r in g]
-        g0, gp = extrapolate(gl, gf) if len(g) >= 3 else (gf[-1], float("nan"))
+        g0, gp = extrapolate(gl, gf) if len(g) >= 3 else (None, float("nan"))
+        line = "| %.1f | %.4f (%.2f) |" % (t, g0, gp) if g0 is not None else \
+            "| %.1f | none (p = %.2f): the finest, %.4f |" % (t, gp, gf[-1])
+        g0 = gf[-1] if g0 is None else g0
         sf = [float(r[k]["sphere_force"]) for r in s]
-        line = "| %.1f | %.4f (%.2f) |" % (t, g0, gp)
         line += "".join(" %.4f (%+.3f %%) |" % (f, 100 * (f / g0 - 1)) for f in gf)
         if len(s) >= 3:
             s0, sp = extrapolate([20.0 / n for n in sn], sf)
-            line += " %.4f (%.2f) %+.3f %% |" % (s0, sp, 100 * (s0 / g0 - 1))
+            line += (" %.4f (%.2f) %+.3f %% |" % (s0, sp, 100 * (s0 / g0 - 1)) if s0 is not None
+                     else " none (p = %.2f) |" % sp)
         line += "".join(" %.4f (%+.3f %%) |" % (f, 100 * (f / g0 - 1)) for f in sf)
         print(line)
     # fields through the thickness at the last travel
     fine = g[-1]
+    print("(reference: the extrapolated 3D force, or where the 3D sequence fits no power law "
+          "with 0.5 < p < 6, the finest 3D run's)")
+    summary = []
     print("\nfields through the thickness at travel %.1f: stamp %s against 3D n=%d"
           % (travels[-1], a.probe_stamp or a.stamp[-1], fine["n"]))
     names = dict(kv.split("=") for kv in a.probes)
@@ -95,6 +103,14 @@ def main():
         with open(files[-1]) as f:
             srows = [[float(v) for v in r.values()] for r in csv.DictReader(f)]
         grows = fine["probes"][key]
+        sa, ga = [r[4:] for r in srows], [r[4:] for r in grows]
+        tmax = max(abs(v[j]) for v in ga for j in (5, 6))
+        errs = []
+        for j, c in enumerate(cols):
+            ref = max(abs(v[j]) for v in ga)
+            e = max(abs(x[j] - y[j]) for x, y in zip(sa, ga))
+            errs.append((c, 100 * e / ref, 100 * e / tmax if c in ("s13", "s23") else None, ref))
+        summary.append((probe, key, errs))
         print("probe %s (x1, x2) = (%s), %s" % (probe, key, os.path.basename(files[-1])))
         print("| x3 | layer |" + "".join(" %s stamp | %s 3D |" % (c, c) for c in cols))
         print("|---|---|" + "---|---|" * len(cols))
@@ -107,6 +123,12 @@ def main():
                 i = 4 + cols.index(c)
                 line += " %.4g | %.4g |" % (sr[i], gr[i])
             print(line)
+    print("\nlargest |stamp - 3D| over the rows, in % of the column's largest |3D| value (that value in "
+          "brackets); for s13, s23 also in % of the probe's largest 3D transverse shear")
+    for probe, key, errs in summary:
+        print("probe %s (%s): " % (probe, key) + ", ".join(
+            "%s %.2f %%%s [%.4g]" % (c, e, "" if et is None else " (%.2f %%)" % et, ref)
+            for c, e, et, ref in errs))
 
 
 if __name__ == "__main__":
