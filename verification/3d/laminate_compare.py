@@ -3,14 +3,16 @@
 and the fields through the thickness under the punch.
 
     /usr/bin/python3 verification/3d/laminate_sphere_getfem.py --n 8 --json > u8.json   # and 12, 16, 20
-    stamp run meshes/laminate-sphere.toml --out s20 --refine=2                         # 20, 40, 80
+    stamp run meshes/laminate-sphere.toml --out s20 --refine=2   # with n = [20, 20]: 20, 40, 80
+    stamp run meshes/laminate-sphere.toml --out s40              # n = 40: the probes
     /usr/bin/python3 verification/3d/laminate_compare.py --getfem u8.json u12.json u16.json \\
-        --stamp s20 s20/refined s20/refined/refined
+        --stamp s20 s20/refined s20/refined2 --probe-stamp s40
 
 Each sequence (the 3D meshes in the order given, stamp's likewise, each halving or refining the
 element side l) is extrapolated to l = 0 from its last three members, F(l) = F0 + C l^p with p
-fitted (p = 2 if the three are not monotone); the force table gives every run's error against
-the extrapolated 3D force. The probe table compares the finest stamp run's thickness_<probe>_0005.csv
+fitted (p = 2 if the three are not monotone; none if p falls outside (0.5, 6): then the finest
+run stands for the limit); the force table gives every run's error against the 3D limit, and
+stamp's extrapolated force against it. --stamp-n gives stamp's n when the first is not 20. The probe table compares the finest stamp run's thickness_<probe>_0005.csv
 with the finest 3D run's fields at the same rows.
 """
 import argparse
