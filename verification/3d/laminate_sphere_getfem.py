@@ -33,7 +33,7 @@ included, one row per ply at an interface): x3, layer, u1, u2, u3, s11, s22, s33
 (second Piola-Kirchhoff stresses in x1, x2, x3, from each ply's law and the strains of the
 element of that ply, as stamp writes them). --json prints one JSON object instead.
 Cost on 2 shared cores (load 4 to 6): n = 8 (8406 unknowns) 111 s, n = 12 (17766) 368 s,
-n = 16 (30582) 633 s. verification/3d/laminate_compare.py puts the runs beside stamp's.
+n = 16 (30582) 633 s, n = 20 (46854) 812 s. verification/3d/laminate_compare.py puts the runs beside stamp's.
 """
 import argparse
 import json
