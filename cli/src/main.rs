@@ -97,7 +97,7 @@ fn main() -> ExitCode {
     };
     // `mpirun -n P stamp ...`: PETSc and MPI for the whole command (see mpi.rs)
     #[cfg(feature = "petsc")]
-    let mut session = match stamp_cli::mpi::Session::start() {
+    let mut ranks = match stamp_cli::mpi::Ranks::start() {
         Ok(s) => s,
         Err(e) => {
             eprintln!("error: {e}");
@@ -105,7 +105,7 @@ fn main() -> ExitCode {
         }
     };
     #[cfg(feature = "petsc")]
-    let out_dir = |out: Option<PathBuf>| session.out_dir(out.as_deref()).map(std::path::Path::to_path_buf);
+    let out_dir = |out: Option<PathBuf>| ranks.out_dir(out.as_deref()).map(std::path::Path::to_path_buf);
     #[cfg(not(feature = "petsc"))]
     let out_dir = |out: Option<PathBuf>| out;
     let result = match cli.command {
@@ -125,7 +125,7 @@ fn main() -> ExitCode {
     let result = result.map_err(|e| e.to_string());
     // every rank ends with the same outcome
     #[cfg(feature = "petsc")]
-    let result = session.finish(result);
+    let result = ranks.finish(result);
     let code = match (result, stdout) {
         (Ok(()), Ok(())) => ExitCode::SUCCESS,
         (Ok(()), Err(e)) => {
@@ -142,6 +142,6 @@ fn main() -> ExitCode {
         }
     };
     #[cfg(feature = "petsc")]
-    session.end();
+    ranks.end();
     code
 }

@@ -1,7 +1,7 @@
 //! `mpirun -n P stamp ...` (the feature `petsc`): PETSc and MPI for the whole command, and the
 //! rules that make P processes behave as one program.
 //!
-//! - PETSc is initialised at the start and finalised at the end ([`Session`]).
+//! - PETSc is initialised at the start and finalised at the end ([`Ranks`]).
 //! - With P > 1 each rank runs its rayon work on one thread: the ranks are the parallelism, and
 //!   the replicated computation (stamp_problem::parallel) must give every rank the same numbers to
 //!   the bit, which a reduction over a varying number of threads would not.
@@ -23,16 +23,16 @@ use std::path::{Path, PathBuf};
 pub const ALONE_AFTER: f64 = 20.0;
 
 /// PETSc for the life of the command.
-pub struct Session {
+pub struct Ranks {
     petsc: Petsc,
     scratch: Option<PathBuf>,
     /// The original stderr (rank > 0 prints nothing else).
     stderr: i32,
 }
 
-impl Session {
+impl Ranks {
     /// Initialise PETSc and MPI, and set the rules above.
-    pub fn start() -> Result<Session, String> {
+    pub fn start() -> Result<Ranks, String> {
         let petsc = Petsc::initialize().map_err(|e| format!("cannot start PETSc and MPI: {e}"))?;
         let (rank, size) = (petsc.rank(), petsc.size());
         let mut scratch = None;
@@ -57,7 +57,7 @@ impl Session {
                 stamp_petsc::petsc::abort_world(101);
             }));
         }
-        Ok(Session { petsc, scratch, stderr })
+        Ok(Ranks { petsc, scratch, stderr })
     }
 
     /// The output folder of this rank: `out` on rank 0, a scratch folder of its own elsewhere.

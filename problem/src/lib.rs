@@ -61,20 +61,27 @@ pub use solve::{default_out_dir, RunOutcome};
 use std::path::Path;
 
 /// Read, build, check, solve and write the problem file `problem` into `out` (default
-/// `<problem dir>/<problem stem>-out`). The checks of [`check::check`] come first: an error stops
-/// the run before anything is written, warnings go to stderr (also with `quiet`), and so does,
-/// after the run, a warning for every punch that never touched the plate. On a Newton failure the
-/// converged steps are written and the error is returned.
+/// `<problem dir>/<problem stem>-out`): [`solve_problem`] on the file's problem.
 pub fn run(problem: &Path, out: Option<&Path>, quiet: bool) -> stamp::Result<RunOutcome> {
     let p = Problem::read(problem)?;
-    let setup = build::build(&p)?;
-    let report = check::check(&p, &setup)?;
+    let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
+    solve_problem(&p, &out_dir, &solve::SolveOptions { quiet, ..Default::default() })
+}
+
+/// Build, check, solve and write the problem `p` into `out_dir`: the pipeline of `stamp run` and
+/// of the Python package's `Problem.solve`. The checks of [`check::check`] come first: an error
+/// stops the run before anything is written, warnings go to stderr (also when quiet), and so do,
+/// after the run, the warnings of [`check::after_the_run`] (a punch that never touched the plate,
+/// a contact zone narrower than the cells). On a Newton failure the converged steps are written
+/// and the error is returned.
+pub fn solve_problem(p: &Problem, out_dir: &Path, options: &solve::SolveOptions) -> stamp::Result<RunOutcome> {
+    let setup = build::build(p)?;
+    let report = check::check(p, &setup)?;
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
-    let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
-    let outcome = solve::solve_and_write(&p, setup, &out_dir, &solve::SolveOptions { quiet, ..Default::default() });
-    for w in check::after_the_run(&p, &out_dir.join("summary.json")) {
+    let outcome = solve::solve_and_write(p, setup, out_dir, options);
+    for w in check::after_the_run(p, &out_dir.join("summary.json")) {
         eprintln!("warning: {w}");
     }
     outcome

@@ -74,16 +74,8 @@ impl NativeProblem {
         let flag = stamp_problem::interrupt::install_chained();
         stamp_problem::interrupt::clear();
         let opts = stamp_problem::solve::SolveOptions { quiet, keep: true, interrupt: flag, ..Default::default() };
-        let outcome = py.detach(|| -> stamp::Result<_> {
-            let setup = stamp_problem::build::build(p)?;
-            let report = stamp_problem::check::check(p, &setup)?;
-            for w in &report.warnings {
-                eprintln!("warning: {w}");
-            }
-            let outcome = stamp_problem::solve::solve_and_write(p, setup, &dir, &opts);
-            for w in stamp_problem::check::after_the_run(p, &dir.join("summary.json")) {
-                eprintln!("warning: {w}");
-            }
+        let outcome = py.detach(|| {
+            let outcome = stamp_problem::solve_problem(p, &dir, &opts);
             let _ = stamp_problem::stdout::finish();
             outcome
         });
