@@ -296,6 +296,11 @@ pub trait NonlinearSolver {
 /// mesh far from the answer).
 pub const PREDICTED_ATTEMPTS: usize = 2;
 
+/// Most halvings of a Newton correction whose iterate an element refuses
+/// ([`StampError::Inadmissible`]: turned inside out) before the attempt is given up (a step of
+/// 2^-12 of the correction).
+pub const ADMISSIBLE_HALVINGS: usize = 12;
+
 /// Newton-Raphson with a direct linear solver, load stepping and cut-back.
 pub struct NewtonRaphson<L: LinearSolver> {
     pub settings: NewtonSettings,
@@ -396,6 +401,8 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         // the iteration from which the budget of max_iterations counts: the last multiplier
         // update inside Newton (a re-solve of the step after end_step had a budget of its own)
         let mut budget_start = 0;
+        // `du` holds the correction added to `u` at the end of the last iteration
+        let mut applied = false;
         for it in 0.. {
             if it > 0 {
                 self.iterations_done += 1;
@@ -405,8 +412,32 @@ impl<L: LinearSolver> NewtonRaphson<L> {
             }
             let (mut ev, mut with_tangent) = match known.take() {
                 Some(ev) => (ev, false),
-                None => (p.evaluate(u, t, true).map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true),
+                None => {
+                    let mut ev = p.evaluate(u, t, true);
+                    // A correction that turned an element inside out (a Newton step from a
+                    // contact state far from the answer: points released or taken in wholesale
+                    // swing the plate through the punch) is halved back towards the last
+                    // admissible iterate until the state is admissible, instead of abandoning
+                    // the load step for a cut-back.
+                    let mut halvings = 0;
+                    while applied && halvings < ADMISSIBLE_HALVINGS && matches!(ev, Err(StampError::Inadmissible { .. })) {
+                        for x in du.iter_mut() {
+                            *x *= -0.5;
+                        }
+                        p.add_increment(u, &du);
+                        for x in du.iter_mut() {
+                            *x = -*x;
+                        }
+                        halvings += 1;
+                        if debug {
+                            eprintln!("  inadmissible iterate: correction halved ({halvings})");
+                        }
+                        ev = p.evaluate(u, t, true);
+                    }
+                    (ev.map_err(|e| (e.to_string(), history.last().copied().unwrap_or(f64::NAN), *last_tol))?, true)
+                }
             };
+            applied = false;
             // augmented Lagrangian inside Newton: once the active set stopped changing and |R| is
             // small, the multipliers are updated here and Newton goes on from this iterate (the
             // update moves the solution a little; the last iterations converge both). The
@@ -569,6 +600,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                 }
             }
             p.add_increment(u, &du);
+            applied = true;
         }
         Err((format!("no convergence in {} iterations", s.max_iterations), history.last().copied().unwrap_or(f64::NAN), *last_tol))
     }
@@ -718,6 +750,9 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                         }
                     }
                     Err((reason, residual, tolerance)) => {
+                        if std::env::var_os("STAMP_DEBUG").is_some() {
+                            eprintln!("  attempt failed: {reason}");
+                        }
                         let spent = self.iterations_done - attempt_start;
                         failed_iterations += spent;
                         summary.failed_iterations += spent;
@@ -775,11 +810,15 @@ mod tests {
         /// augmented-Lagrangian update inside Newton); |R| at each call that did.
         multiplier_updates: usize,
         updated_at: Vec<f64>,
+        /// States with u - t above this are refused as inadmissible (an element turned inside
+        /// out); how many evaluations were refused.
+        refuse_above: f64,
+        refused: usize,
     }
 
     impl Line {
         fn new() -> Self {
-            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0, extra_solves: 0, shift: 0.0, multiplier_updates: 0, updated_at: Vec::new() }
+            Line { residual: [0.0], col_ptr: [0, 1], row_idx: [0], tangent: [1.0], nan_above: f64::INFINITY, never_satisfied: false, restarts: 0, extra_solves: 0, shift: 0.0, multiplier_updates: 0, updated_at: Vec::new(), refuse_above: f64::INFINITY, refused: 0 }
         }
     }
 
@@ -792,6 +831,10 @@ mod tests {
         }
         fn apply_prescribed(&self, _u: &mut [f64], _t: f64) {}
         fn evaluate(&mut self, u: &[f64], t: f64, _with_tangent: bool) -> Result<Evaluation> {
+            if u[0] - t > self.refuse_above {
+                self.refused += 1;
+                return Err(StampError::Inadmissible { element: 0, reason: "turned inside out".into() });
+            }
             self.residual[0] = if t > self.nan_above { f64::NAN } else { u[0] - t - self.shift };
             Ok(Evaluation { residual_norm: self.residual[0].abs(), force_scale: 1.0, active_changes: 0 })
         }
@@ -824,6 +867,30 @@ mod tests {
 
     fn settings() -> NewtonSettings {
         NewtonSettings { max_increment: 0.25, max_cutbacks: 2, ..NewtonSettings::default() }
+    }
+
+    /// A Newton correction whose iterate an element refuses is halved back towards the last
+    /// admissible iterate, and the step goes on without a cut-back: a tangent of 0.6 for the
+    /// true 1 overshoots each correction by 2/3, and states more than 0.1 beyond the answer are
+    /// refused, so the first correction of the first step (0.25 / 0.6, 0.17 beyond) is refused
+    /// and halved; the step then converges from below.
+    #[test]
+    fn an_inadmissible_iterate_halves_the_correction_instead_of_cutting_back() {
+        let mut newton = NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_iterations: 100, ..settings() });
+        let mut p = Line::new();
+        p.tangent = [0.6];
+        p.refuse_above = 0.1;
+        let mut u = vec![0.0];
+        let summary = newton.solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).unwrap();
+        assert!(p.refused >= 1, "the overshooting correction was refused");
+        assert_eq!(summary.cutbacks, 0);
+        assert_eq!(summary.steps, 4);
+        assert!((u[0] - 1.0).abs() < 1e-6, "{}", u[0]);
+        // with nothing to halve (a refused start) the attempt still fails and is cut back
+        let mut q = Line::new();
+        q.refuse_above = -1.0;
+        let mut v = vec![0.0];
+        assert!(NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut q, &mut v, 0.0, &[1.0], &mut |_, _, _| {}).is_err());
     }
 
     /// A predictor that hits the answer (u = t) starts every step converged: no iteration; it

@@ -196,3 +196,26 @@ fn a_residual_only_evaluation_reports_the_true_changes_and_holds_nothing_back() 
     assert!(force[8] != 0.0, "the shallow penetration acts in a residual-only evaluation");
     assert_eq!(p.last_active, vec![false; 4]);
 }
+
+#[test]
+fn barely_tensile_points_leave_after_the_most_tensile_one() {
+    // all four points in contact (Psi = 0), then three lift off by 1, 0.8 and 0.02 (trials 10, 8
+    // and 0.2): those at or above RELEASE_FRACTION (5 %) of the most tensile trial leave at
+    // once; the barely tensile one stays active with its exact (tensile) force, counted as a
+    // change, and leaves at the next evaluation, when it is the most tensile
+    let mut p = pair(0.5);
+    assert_eq!(p.release_fraction, RELEASE_FRACTION);
+    evaluate(&mut p, [1e-3; 4]);
+    assert_eq!(evaluate(&mut p, [1e-3; 4]), (0, vec![true; 4]), "settled in contact");
+    let lifted = [-1.0 + 1e-3, -0.8 + 1e-3, -0.02 + 1e-3, 1e-3];
+    assert_eq!(evaluate(&mut p, lifted), (3, vec![false, false, true, true]));
+    assert!((p.state[2].lambda - 0.2).abs() < 1e-12, "held with its exact trial multiplier");
+    assert_eq!(evaluate(&mut p, lifted), (1, vec![false, false, false, true]), "then released");
+    assert_eq!(evaluate(&mut p, lifted).0, 0);
+    // release_fraction = 0: every tensile point leaves at once
+    let mut q = pair(0.5);
+    q.release_fraction = 0.0;
+    evaluate(&mut q, [1e-3; 4]);
+    evaluate(&mut q, [1e-3; 4]);
+    assert_eq!(evaluate(&mut q, lifted), (3, vec![false, false, false, true]));
+}
