@@ -342,3 +342,55 @@ fn bad_thickness_probes_are_refused_by_name() {
     let err = stamp_cli::run::run(&path, Some(&dir.join("outside")), true).err().expect("refused").to_string();
     assert!(err.contains("output.thickness_probe[0].at") && err.contains("not on the plate"), "{err}");
 }
+
+/// A thickness probe on a node or an edge averages the cells that hold the point, and on a
+/// symmetry plane their mirror images: Pagano's [0/90/90/0] plate (a/h = 4) whole on 8 x 8
+/// elements and its quarter on 4 x 4 give the same rows to round-off at the centre (a node of four
+/// cells in the whole plate, a corner on both symmetry planes of the quarter), on the symmetry
+/// line between two nodes (an inner edge of the whole plate) and inside a cell; at the centre the
+/// transverse shears and s12 vanish (to round-off in the whole plate, exactly in the quarter).
+#[test]
+fn thickness_probes_average_cells_and_mirror_images() {
+    let dir = temp_dir("laminate-probe-nodes");
+    let (sr, le) = (4.0, 0.5);
+    let probes = [("centre", 2.0, 2.0), ("edge", 2.0, 2.0 - 0.5 * le), ("inside", 2.0 - 0.3 * le, 2.0 - 0.2 * le)];
+    let mut text = pagano_general(&[0.0, 90.0, 90.0, 0.0], sr, 4, 3);
+    text.truncate(text.find("\n[[output.thickness_probe]]").unwrap());
+    for (name, x, y) in probes {
+        text += &format!("\n[[output.thickness_probe]]\nname = \"{name}\"\nat = [{x}, {y}]\npoints_per_layer = 4\n");
+    }
+    let whole = text
+        .replace("x = [0.0, 2], y = [0.0, 2], n = [4, 4]", "x = [0.0, 4], y = [0.0, 4], n = [8, 8]")
+        .replace("fix = [\"symmetry_x1\"]", "fix = [\"v2\", \"v3\"]")
+        .replace("fix = [\"symmetry_x2\"]", "fix = [\"v1\", \"v3\"]");
+    assert!(whole.contains("n = [8, 8]") && !whole.contains("symmetry"), "{whole}");
+    let mut tables = Vec::new();
+    for (name, t) in [("quarter", &text), ("whole", &whole)] {
+        let path = write(&dir, &format!("{name}.toml"), t);
+        let out = dir.join(name);
+        stamp_cli::run::run(&path, Some(&out), true).unwrap();
+        tables.push(probes.map(|(p, _, _)| read_csv(&out.join(format!("thickness_{p}_0001.csv")))));
+    }
+    for (i, (p, _, _)) in probes.iter().enumerate() {
+        let (q, w) = (&tables[0][i], &tables[1][i]);
+        assert_eq!(q.len(), 16);
+        for col in 2..11 {
+            // the column's largest value over the three probes
+            let scale = tables[1].iter().flatten().map(|r| r[col].abs()).fold(0.0, f64::max);
+            for (a, b) in q.iter().zip(w) {
+                assert!((a[col] - b[col]).abs() <= 1e-8 * scale, "{p}, column {col}: quarter {} whole {}", a[col], b[col]);
+            }
+        }
+    }
+    let (q, w) = (&tables[0][0], &tables[1][0]);
+    // round-off against the stresses' size: the largest s11 at the centre
+    let s11_max = w.iter().map(|r| r[5].abs()).fold(0.0, f64::max);
+    assert!(s11_max > 0.0);
+    for (a, b) in q.iter().zip(w) {
+        for col in [8, 9, 10] {
+            assert_eq!(a[col], 0.0, "quarter's centre, column {col}");
+            assert!(b[col].abs() <= 1e-12 * s11_max, "whole plate's centre, column {col}: {} (s11 up to {s11_max})", b[col]);
+        }
+        assert!(a[5].abs() > 0.0 && a[4] != 0.0);
+    }
+}
