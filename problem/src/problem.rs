@@ -464,8 +464,13 @@ pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>
     for (i, s) in probes.iter().enumerate() {
         let spec = s.get_ref();
         let key = format!("output.thickness_probe[{i}]");
-        if p.spec.plate.get_ref().layers.is_none() {
-            return Err(p.error_at(s.span(), &key, "the stresses through the thickness are those of a laminate's layers: the plate needs `layers`"));
+        let plate = p.spec.plate.get_ref();
+        if plate.layers.is_none() && plate.surfaces() < 3 {
+            return Err(p.error_at(
+                s.span(),
+                &key,
+                "the stresses through the thickness are those of the 3D law: the plate needs `layers` or `surfaces` = 3 to 5 (the two-surface plate has the paper's plane-stress law)",
+            ));
         }
         let name = &spec.name;
         if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {

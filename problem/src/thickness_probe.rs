@@ -1,8 +1,9 @@
 //! `[[output.thickness_probe]]`: the displacement and the six stresses through the thickness of a
-//! laminate at one point of the plate, written for every written step as
-//! `thickness_<name>_<step>.csv` with the columns `x3, layer, u1, u2, u3, s11, s22, s33, s12, s13,
-//! s23` (`layer` counts from 0 at the bottom; `points_per_layer` rows per layer, evenly spaced, its
-//! faces included, so an interface has one row for each of its two layers).
+//! laminate, or of a plate of three to five surfaces (one layer of its material), at one point of
+//! the plate, written for every written step as `thickness_<name>_<step>.csv` with the columns
+//! `x3, layer, u1, u2, u3, s11, s22, s33, s12, s13, s23` (`layer` counts from 0 at the bottom;
+//! `points_per_layer` rows per layer, evenly spaced, its faces included, so an interface has one
+//! row for each of its two layers).
 //!
 //! The stresses are the second Piola-Kirchhoff stresses in the plate's axes by each layer's 3D law
 //! from the element's strains at the four Gauss points, extrapolated bilinearly to the point (the
@@ -64,7 +65,7 @@ impl ThicknessProbes {
     pub fn write_step(&self, dir: &Path, step: usize, model: &Model<Plate>, u: &[f64]) -> Result<Vec<PathBuf>> {
         let mut files = Vec::new();
         for item in &self.items {
-            let text = csv(item, model, u).ok_or_else(|| StampError::Input { file: String::new(), message: "a thickness probe needs a laminate".into() })?;
+            let text = csv(item, model, u).ok_or_else(|| StampError::Input { file: String::new(), message: "a thickness probe needs a plate of three to five surfaces or layers".into() })?;
             let path = dir.join(format!("thickness_{}_{step:04}.csv", item.name));
             write_string_atomically(&path, &text)?;
             files.push(path);
@@ -94,7 +95,7 @@ fn on_symmetry_plane(p: &Problem, mesh: &MeshData, at: [f64; 2], d: usize) -> bo
 /// The rows of one probe.
 fn csv(item: &Item, model: &Model<Plate>, u: &[f64]) -> Option<String> {
     let plate = &model.element;
-    let (lam, per_layer) = plate.laminate()?;
+    let (lam, per_layer, mid) = plate.stress_stack()?;
     let dpn = plate.dofs_per_node();
     let mut ws = plate.new_workspace();
     let b = lam.boundaries();
@@ -138,7 +139,7 @@ fn csv(item: &Item, model: &Model<Plate>, u: &[f64]) -> Option<String> {
                     row[r] = 0.0;
                 }
             }
-            out.push_str(&format!("{:e},{k}", x3));
+            out.push_str(&format!("{:e},{k}", x3 + mid));
             for v in row {
                 out.push_str(&format!(",{v:e}"));
             }
