@@ -16,6 +16,7 @@
 //! transverse stresses of the two layers differ by what the model has not converged
 //! (docs/verification.md measures it against Pagano's exact solution).
 
+use super::equilibrium_shear::ShearRecovery;
 use super::mesh::MeshData;
 use super::plate_model::Plate;
 use super::probe::CellLocator;
@@ -33,6 +34,8 @@ struct Item {
     /// Whether the point lies on a symmetry plane of normal x1, x2.
     mirror: [bool; 2],
     points: usize,
+    /// With `transverse_shear = "equilibrium"`: the in-plane stresses' recovery around the point.
+    recovery: Option<ShearRecovery>,
 }
 
 /// The thickness probes of a run.
@@ -56,7 +59,11 @@ impl ThicknessProbes {
                 return Err(p.error_at(s.span(), &format!("output.thickness_probe[{i}].at"), format!("the point {:?} is not on the plate (the mesh)", spec.at)));
             }
             let mirror = [0, 1].map(|d| on_symmetry_plane(p, mesh, spec.at, d));
-            items.push(Item { name: spec.name.clone(), cells, mirror, points: spec.points_per_layer.unwrap_or(DEFAULT_POINTS_PER_LAYER) });
+            let recovery = (spec.transverse_shear.as_deref() == Some("equilibrium")).then(|| {
+                let holding: Vec<usize> = cells.iter().map(|c| c.0).collect();
+                ShearRecovery::new(&mesh.mesh, &holding, spec.at, mirror)
+            });
+            items.push(Item { name: spec.name.clone(), cells, mirror, points: spec.points_per_layer.unwrap_or(DEFAULT_POINTS_PER_LAYER), recovery });
         }
         Ok(ThicknessProbes { items })
     }
@@ -127,6 +134,11 @@ fn csv(item: &Item, model: &Model<Plate>, u: &[f64]) -> Option<String> {
                 for (r, c) in [(3, 0), (4, 1), (5, 2), (6, 5), (7, 4), (8, 3)] {
                     row[r] += weight * (0..4).map(|q| at_gauss[q] * g[q][c]).sum::<f64>();
                 }
+            }
+            if let Some(r) = &item.recovery {
+                let [s13, s23] = r.shear(plate, &lam, u, k, x3)?;
+                row[7] = s13;
+                row[8] = s23;
             }
             // a mirror image's odd components cancel the cell's
             if item.mirror[0] {
