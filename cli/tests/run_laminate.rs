@@ -343,6 +343,9 @@ fn bad_thickness_probes_are_refused_by_name() {
             assert!(err.contains(w), "{name}: '{w}' missing from: {err}");
         }
     }
+    let path = write(&dir, "strip.toml", &(pagano_problem(2, 3).replace("n = [2, 2]", "n = [4, 1]") + &probe("[1.0, 1.0]", "transverse_shear = \"equilibrium\"\n")));
+    let err = stamp_cli::run::run(&path, Some(&dir.join("strip")), true).err().expect("refused").to_string();
+    assert!(err.contains("output.thickness_probe[0].transverse_shear") && err.contains("one cell wide"), "{err}");
     let path = write(&dir, "outside.toml", &(pagano_problem(2, 3) + &probe("[7.0, 1.0]", "")));
     let err = stamp_cli::run::run(&path, Some(&dir.join("outside")), true).err().expect("refused").to_string();
     assert!(err.contains("output.thickness_probe[0].at") && err.contains("not on the plate"), "{err}");

@@ -38,7 +38,9 @@ pub struct ShearRecovery {
 impl ShearRecovery {
     /// The patch around `at` held by `holding` (cells) and two rings of neighbours, mirrored
     /// across the planes of `mirror`.
-    pub fn new(mesh: &QuadMesh, holding: &[usize], at: [f64; 2], mirror: [bool; 2]) -> ShearRecovery {
+    /// None when the cells' centres do not determine a quadratic (too few, or in a line: a strip
+    /// one cell wide).
+    pub fn new(mesh: &QuadMesh, holding: &[usize], at: [f64; 2], mirror: [bool; 2]) -> Option<ShearRecovery> {
         let mut cells: Vec<usize> = holding.to_vec();
         for _ring in 0..2 {
             let nodes: Vec<usize> = cells.iter().flat_map(|&c| mesh.cells[c]).collect();
@@ -73,7 +75,11 @@ impl ShearRecovery {
                 }
             }
         }
-        let inv = m.try_inverse().unwrap_or_else(nalgebra::Matrix6::zeros);
+        let sv = m.singular_values();
+        if !(sv.min() > 1e-10 * sv.max()) {
+            return None;
+        }
+        let inv = m.try_inverse()?;
         let points = samples
             .iter()
             .map(|&(i, p, sign)| {
@@ -81,7 +87,7 @@ impl ShearRecovery {
                 (i, [w[1] / size, w[2] / size], [sign * w[1] / size, sign * w[2] / size])
             })
             .collect();
-        ShearRecovery { cells, points }
+        Some(ShearRecovery { cells, points })
     }
 
     /// [s11,1 + s12,2, s12,1 + s22,2] at height x3 of layer k.

@@ -59,10 +59,18 @@ impl ThicknessProbes {
                 return Err(p.error_at(s.span(), &format!("output.thickness_probe[{i}].at"), format!("the point {:?} is not on the plate (the mesh)", spec.at)));
             }
             let mirror = [0, 1].map(|d| on_symmetry_plane(p, mesh, spec.at, d));
-            let recovery = (spec.transverse_shear.as_deref() == Some("equilibrium")).then(|| {
+            let recovery = if spec.transverse_shear.as_deref() == Some("equilibrium") {
                 let holding: Vec<usize> = cells.iter().map(|c| c.0).collect();
-                ShearRecovery::new(&mesh.mesh, &holding, spec.at, mirror)
-            });
+                Some(ShearRecovery::new(&mesh.mesh, &holding, spec.at, mirror).ok_or_else(|| {
+                    p.error_at(
+                        s.span(),
+                        &format!("output.thickness_probe[{i}].transverse_shear"),
+                        format!("\"equilibrium\" fits the in-plane stresses of the cells around {:?}, but their centres do not span a quadratic in x1 and x2 (too few cells, or a strip one cell wide): use \"law\" or a finer mesh", spec.at),
+                    )
+                })?)
+            } else {
+                None
+            };
             items.push(Item { name: spec.name.clone(), cells, mirror, points: spec.points_per_layer.unwrap_or(DEFAULT_POINTS_PER_LAYER), recovery });
         }
         Ok(ThicknessProbes { items })
