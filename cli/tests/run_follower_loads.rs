@@ -123,3 +123,125 @@ fn bad_moment_and_follower_keys_name_the_key_and_line() {
     let e = error_of("moment_surface", &roll.replace("group = \"right\"", "group = \"all\""));
     assert!(e.contains("load[0].group") && e.contains("curve"), "{e}");
 }
+
+/// The total force of a pressure given as an expression p(x1, x2) on the top face of one cell
+/// [0, 2] x [0, 1] (three surfaces, nonlinear) whose face nodes are all prescribed to the affine
+/// motion x -> R S x at load factor 1 (S stretches x1 by 1.2 and x2 by 0.9, R turns by 60 degrees
+/// about x2; the mid-surface is free). A follower pressure acts on the deformed face: its total is
+/// -1.2 * 0.9 * int p dA * R e3, R e3 = (sin 60, 0, cos 60), to round-off (p bilinear: the 2 x 2
+/// Gauss points integrate it exactly); a dead one stays -int p dA e3. Both balanced by the supports.
+#[test]
+fn expression_pressure_totals_on_a_turned_and_stretched_face() {
+    let dir = temp_dir("follower-expression");
+    let (l, w, h, l1, l2, theta) = (2.0f64, 1.0f64, 0.1f64, 1.2f64, 0.9f64, 60f64.to_radians());
+    let (s, c) = theta.sin_cos();
+    // u = R S X - X on each face x3 = -+h/2 of the left (x1 = 0) and right (x1 = l) edges
+    let face = |x1: f64, x3: f64| (l1 * x1 * c + x3 * s - x1, -l1 * x1 * s + x3 * c - x3);
+    let edge = |group: &str, x1: f64| {
+        let (bot, top) = (face(x1, -0.5 * h), face(x1, 0.5 * h));
+        format!("[[boundary]]\ngroup = \"{group}\"\nprescribe = {{ \"v1-\" = {:e}, \"v3-\" = {:e}, \"v1+\" = {:e}, \"v3+\" = {:e} }}\n\n", bot.0, bot.1, top.0, top.1)
+    };
+    let base = format!(
+        r#"[mesh]
+rectangle = {{ x = [0.0, {l}], y = [0.0, {w}], n = [1, 1] }}
+
+[plate]
+thickness = {h}
+E = 1.0e3
+nu = 0.3
+surfaces = 3
+
+{}{}[[boundary]]
+group = "bottom"
+fix = ["v2"]
+
+[[boundary]]
+group = "top"
+prescribe = {{ "v2" = {:e} }}
+
+[[load]]
+type = "pressure"
+group = "all"
+pressure = "1 + 0.5*x1 + 0.25*x2 + 0.1*x1*x2"
+face = "top"
+follower = true
+
+[solver]
+max_increment = 0.1
+"#,
+        edge("left", 0.0),
+        edge("right", l),
+        (l2 - 1.0) * w
+    );
+    // int p dA over [0, l] x [0, w]
+    let total = l * w + 0.5 * 0.5 * l * l * w + 0.25 * 0.5 * l * w * w + 0.1 * 0.25 * l * l * w * w;
+    for follower in [true, false] {
+        let text = if follower { base.clone() } else { base.replace("follower = true\n", "") };
+        let path = write(&dir, &format!("face-{follower}.toml"), &text);
+        let out = dir.join(format!("out-{follower}"));
+        stamp_cli::run::run(&path, Some(&out), true).unwrap();
+        let e = summary(&out)["steps"].as_array().unwrap().last().unwrap().clone();
+        assert_eq!(e["load_factor"].as_f64(), Some(1.0));
+        let applied: Vec<f64> = (0..3).map(|k| e["applied_load"][k].as_f64().unwrap()).collect();
+        let support: Vec<f64> = (0..3).map(|k| e["support_reaction"][k].as_f64().unwrap()).collect();
+        let want = if follower { [-l1 * l2 * total * s, 0.0, -l1 * l2 * total * c] } else { [0.0, 0.0, -total] };
+        println!("follower = {follower}: applied {applied:?}, closed form {want:?}");
+        for k in 0..3 {
+            assert!((applied[k] - want[k]).abs() <= 1e-10 * total, "follower = {follower}: applied load {applied:?} against {want:?}");
+            assert!((applied[k] + support[k]).abs() <= 1e-8 * total, "follower = {follower}: applied {applied:?} and supports {support:?} do not balance");
+        }
+        // the face really turned and stretched: the top-right corner's top face at R S X
+        let d = &e["points"]["corner_ur"]["displacement_top"];
+        let (u1, u3) = face(l, 0.5 * h);
+        assert!((d[0].as_f64().unwrap() - u1).abs() < 1e-12 && (d[2].as_f64().unwrap() - u3).abs() < 1e-12, "{d}");
+    }
+}
+
+/// A dead pressure given as an expression on a simply supported plate on a mesh of unequal cells:
+/// the supports carry its integral, int p dA over [0, 4] x [0, 3] = 52.2 for p = 1 + 0.5 x1 +
+/// 0.25 x2^2 + 0.1 x1^3 (cubic at most along each axis: the 2 x 2 Gauss points are exact), to
+/// round-off.
+#[test]
+fn expression_pressure_reactions_carry_its_integral() {
+    let dir = temp_dir("expression-pressure-total");
+    let text = r#"[mesh]
+rectangle = { x = [0.0, 4.0], y = [0.0, 3.0], n = [7, 5] }
+
+[plate]
+thickness = 0.2
+E = 1.0e4
+nu = 0.3
+kinematics = "linear"
+
+[[boundary]]
+group = "left"
+fix = ["v1", "v2", "v3"]
+
+[[boundary]]
+group = "right"
+fix = ["v3"]
+
+[[boundary]]
+group = "bottom"
+fix = ["v3"]
+
+[[boundary]]
+group = "top"
+fix = ["v3"]
+
+[[load]]
+type = "pressure"
+group = "all"
+pressure = "1 + 0.5*x1 + 0.25*x2*x2 + 0.1*x1*x1*x1"
+face = "top"
+"#;
+    let path = write(&dir, "p.toml", text);
+    let out = dir.join("out");
+    stamp_cli::run::run(&path, Some(&out), true).unwrap();
+    let e = summary(&out)["steps"].as_array().unwrap().last().unwrap().clone();
+    let total = 4.0 * 3.0 + 0.5 * 8.0 * 3.0 + 0.25 * 4.0 * 9.0 + 0.1 * 64.0 * 3.0;
+    let support = e["support_reaction"][2].as_f64().unwrap();
+    let applied = e["applied_load"][2].as_f64().unwrap();
+    println!("supports {support}, applied {applied}, int p dA {total}");
+    assert!((support - total).abs() <= 1e-10 * total && (applied + total).abs() <= 1e-12 * total, "supports {support}, applied {applied}, integral {total}");
+}

@@ -176,3 +176,99 @@ fn check_names_the_model_and_bad_keys_are_refused() {
         }
     }
 }
+
+/// The 3D stresses of a plate of four surfaces without layers, at every surface in the .vtu and
+/// through the thickness in a thickness probe: a uniform stretch e along x1, free to contract (a
+/// face offset from x3 = 0: delta- = -0.05, delta+ = 0.15), is 3D elasticity's uniaxial stress
+/// s11 = E e, the other five 0, u = (e x1, -nu e x2, -nu e (x3 - delta-)), exactly (a patch test),
+/// in every cell, at every surface, inside a cell, at a node and at a corner on two symmetry planes.
+#[test]
+fn stresses_of_a_plate_without_layers_at_every_surface() {
+    let dir = temp_dir("multi-surface-stresses");
+    let (e, l, dm) = (1.0e-3, 2.0, -0.05);
+    let text = format!(
+        r#"[mesh]
+rectangle = {{ x = [0.0, {l}], y = [0.0, 1.0], n = [3, 2] }}
+
+[plate]
+delta_minus = {dm}
+delta_plus = 0.15
+E = {E}
+nu = {NU}
+surfaces = 4
+kinematics = "linear"
+
+[[boundary]]
+group = "left"
+fix = ["symmetry_x1", "v3-"]
+
+[[boundary]]
+group = "bottom"
+fix = ["symmetry_x2"]
+
+[[boundary]]
+group = "right"
+prescribe = {{ "v1" = {} }}
+
+[[output.thickness_probe]]
+name = "inside"
+at = [0.7, 0.4]
+points_per_layer = 5
+
+[[output.thickness_probe]]
+name = "node"
+at = [{}, 0.5]
+
+[[output.thickness_probe]]
+name = "corner"
+at = [0.0, 0.0]
+"#,
+        e * l,
+        l / 3.0
+    );
+    let path = write(&dir, "stretch.toml", &text);
+    let out = dir.join("out");
+    stamp_cli::run::run(&path, Some(&out), true).unwrap();
+    let s11 = E * e;
+    let arrays = summary(&out)["cell_arrays"].clone();
+    // the .vtu: [s11, s22, s33, s12, s23, s13] in every cell at each of the four surfaces
+    // the last written step: load factor 1
+    let last = |prefix: &str| {
+        let mut f: Vec<String> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).filter(|f| f.starts_with(prefix)).collect();
+        f.sort();
+        out.join(f.last().unwrap())
+    };
+    assert_eq!(last_step(&out)["load_factor"].as_f64(), Some(1.0));
+    let vtk = vtkio::Vtk::import(last("stretch_0")).unwrap();
+    let vtkio::model::DataSet::UnstructuredGrid { pieces, .. } = vtk.data else { panic!("not an unstructured grid") };
+    let vtkio::model::Piece::Inline(piece) = &pieces[0] else { panic!("not inline") };
+    for s in 0..4 {
+        let name = format!("stress_layer0_surface{s}");
+        assert!(arrays.as_array().unwrap().iter().any(|a| a == &Value::from(name.clone())), "{name} not in {arrays}");
+        let data = piece.data.cell.iter().find_map(|a| match a {
+            vtkio::model::Attribute::DataArray(d) if d.name == name => Some(d.data.clone().cast_into::<f64>().unwrap()),
+            _ => None,
+        });
+        let data = data.unwrap_or_else(|| panic!("{name} missing from the .vtu"));
+        assert_eq!(data.len(), 6 * 6);
+        for cell in data.chunks(6) {
+            let want = [s11, 0.0, 0.0, 0.0, 0.0, 0.0];
+            for c in 0..6 {
+                assert!((cell[c] - want[c]).abs() <= 1e-9 * s11, "{name}: {cell:?} against {want:?}");
+            }
+        }
+    }
+    for (probe, x1, x2) in [("inside", 0.7, 0.4), ("node", l / 3.0, 0.5), ("corner", 0.0, 0.0)] {
+        let text = std::fs::read_to_string(last(&format!("thickness_{probe}_"))).unwrap();
+        let rows: Vec<Vec<f64>> = text.lines().skip(1).map(|r| r.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+        assert_eq!(rows.len(), if probe == "inside" { 5 } else { 9 });
+        assert!((rows[0][0] - dm).abs() < 1e-15 && (rows.last().unwrap()[0] - 0.15).abs() < 1e-15, "x3 from the bottom face to the top: {text}");
+        for r in &rows {
+            let want = [r[0], 0.0, e * x1, -NU * e * x2, -NU * e * (r[0] - dm), s11, 0.0, 0.0, 0.0, 0.0, 0.0];
+            for c in 2..11 {
+                let scale = if c < 5 { e } else { s11 };
+                assert!((r[c] - want[c]).abs() <= 1e-9 * scale, "{probe}, column {c}: {r:?} against {want:?}");
+            }
+        }
+    }
+}

@@ -289,6 +289,23 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
         r
     }
 
+    /// The six stresses (second Piola-Kirchhoff, Voigt order [11, 22, 33, 23, 13, 12]) in the
+    /// plate's axes x1, x2, x3 at `x3` from the middle of the section at the four Gauss points of
+    /// element `e`, by the 3D law of the section's layer there from the element's strains (the
+    /// assumed strains, as [`crate::LaminatePlate::stresses_at`]); their mean is the value at the
+    /// element's centre.
+    pub fn stresses_at(&self, e: usize, x3: f64, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>) -> [[f64; 6]; 4] {
+        let h = self.section.thickness();
+        let mid = 0.5 * (self.section.delta_minus + self.section.delta_plus);
+        let level = Level::<N>::at(x3, h, &surface_zetas(N), 0);
+        let geo = &self.geometry[e];
+        compute_samples(geo, std::slice::from_ref(&level), self.kinematics, v, ws);
+        let k = self.section.layers.iter().rposition(|l| x3 + mid >= l.bottom).unwrap_or(0);
+        let law = self.laws[k];
+        let angle = geo.frame[0][1].atan2(geo.frame[0][0]);
+        std::array::from_fn(|g| crate::orthotropic::rotate_stress(&law.stress(&strain(geo, ws.samples(), 0, g)), -angle))
+    }
+
     /// The smallest volume ratio det[g1, g2, g3] / det[G1, G2, G3] over the integration points of
     /// element `e` at local dofs `v` (1 in the reference state and under any rigid motion; <= 0 once
     /// the element turned inside out).

@@ -50,6 +50,7 @@ pub mod richardson;
 pub mod rigid_modes;
 pub mod solve;
 pub mod table;
+pub mod equilibrium_shear;
 pub mod thickness_probe;
 pub mod travel_modes;
 pub mod units;

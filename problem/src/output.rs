@@ -164,11 +164,11 @@ pub struct ContactRow {
     pub active: bool,
 }
 
-/// The names of the cell arrays of a run's .vtu: the resultants, and with layers the stresses at
-/// every surface of every layer (see [`layer_stress_fields`]).
+/// The names of the cell arrays of a run's .vtu: the resultants, and with layers or three to five
+/// surfaces the stresses at every surface of every layer (see [`layer_stress_fields`]).
 pub fn cell_array_names(plate: &Plate) -> Vec<String> {
     let mut v: Vec<String> = CELL_ARRAYS.iter().map(|s| s.to_string()).collect();
-    if let Some((lam, per_layer)) = plate.laminate() {
+    if let Some((lam, per_layer, _)) = plate.stress_stack() {
         for k in 0..lam.plies.len() {
             for s in 0..per_layer {
                 v.push(stress_field_name(k, s));
@@ -182,13 +182,13 @@ fn stress_field_name(layer: usize, surface: usize) -> String {
     format!("stress_layer{layer}_surface{surface}")
 }
 
-/// With layers: per layer k and surface s of it (from its bottom up, its faces included: an
-/// interface in each of its two layers), `stress_layer<k>_surface<s>`, the six second
+/// With layers, or three to five surfaces (one layer, k = 0): per layer k and surface s of it
+/// (from its bottom up, its faces included: an interface in each of its two layers), `stress_layer<k>_surface<s>`, the six second
 /// Piola-Kirchhoff stresses in the plate's axes at the element centre (the mean over its Gauss
 /// points) by the layer's 3D law, as a symmetric tensor in VTK's order [s11, s22, s33, s12, s23, s13].
 pub fn layer_stress_fields(model: &Model<Plate>, u: &[f64]) -> Vec<Field> {
     let plate = &model.element;
-    let Some((lam, per_layer)) = plate.laminate() else {
+    let Some((lam, per_layer, _)) = plate.stress_stack() else {
         return Vec::new();
     };
     let b = lam.boundaries();
@@ -205,7 +205,7 @@ pub fn layer_stress_fields(model: &Model<Plate>, u: &[f64]) -> Vec<Field> {
         for k in 0..nl {
             for s in 0..per_layer {
                 let x3 = b[k] + (b[k + 1] - b[k]) * s as f64 / (per_layer - 1) as f64;
-                let g = plate.layer_stresses(e, k, x3, &local, &mut ws).expect("a laminate");
+                let g = plate.layer_stresses(e, k, x3, &local, &mut ws).expect("a stack of the 3D law");
                 let mean = |c: usize| 0.25 * g.iter().map(|p| p[c]).sum::<f64>();
                 out[k * per_layer + s].extend([mean(0), mean(1), mean(2), mean(5), mean(3), mean(4)]);
             }

@@ -11,7 +11,7 @@ use stamp_elements::multi_surface::{lagrange, surface_zetas, MultiSurfaceWorkspa
 use stamp_elements::plate::PlateWorkspace;
 use stamp_elements::laminate::LaminateWorkspace;
 use stamp_elements::{
-    FiveSurfaceLaminate, FiveSurfacePlate, FourSurfaceLaminate, FourSurfacePlate, Kinematics, Laminate, PlateElements, Section, ThreeSurfaceLaminate, ThreeSurfacePlate,
+    FiveSurfaceLaminate, FiveSurfacePlate, FourSurfaceLaminate, FourSurfacePlate, Kinematics, Laminate, Ply, PlyMaterial, PlateElements, Section, ThreeSurfaceLaminate, ThreeSurfacePlate,
 };
 use stamp_elements::Face;
 
@@ -86,14 +86,34 @@ impl Plate {
             _ => None,
         }
     }
-    /// The six stresses (Voigt order [11, 22, 33, 23, 13, 12], the plate's axes) at height `x3` of
-    /// layer `k` of element `e` at its four Gauss points, by the layer's 3D law; None for a plate
-    /// without layers.
+    /// The stack whose stresses the output writes, the surfaces in each of its layers, and x3 of
+    /// its mid-plane: a laminate's plies (mid-plane 0), or for a plate of three to five surfaces
+    /// without layers one layer of the plate's thickness and material (mid-plane between its
+    /// faces); None for the paper's two-surface plate, whose law is not the 3D one.
+    pub fn stress_stack(&self) -> Option<(Laminate, usize, f64)> {
+        if let Some((lam, per_layer)) = self.laminate() {
+            return Some((lam.clone(), per_layer, 0.0));
+        }
+        let (section, n) = match self {
+            Plate::ThreeSurface(p) => (p.section(), 3),
+            Plate::FourSurface(p) => (p.section(), 4),
+            Plate::FiveSurface(p) => (p.section(), 5),
+            _ => return None,
+        };
+        let ply = Ply { thickness: section.thickness(), material: PlyMaterial::Isotropic(section.layers[0].material), angle: 0.0 };
+        Some((Laminate::new(vec![ply]).expect("a valid section"), n, 0.5 * (section.delta_minus + section.delta_plus)))
+    }
+    /// The six stresses (Voigt order [11, 22, 33, 23, 13, 12], the plate's axes) at height `x3`
+    /// (from the mid-plane of [`Plate::stress_stack`]) of its layer `k` of element `e` at the four
+    /// Gauss points, by the layer's 3D law; None for the two-surface plate.
     pub fn layer_stresses(&self, e: usize, k: usize, x3: f64, v: &[f64], ws: &mut PlateWs) -> Option<[[f64; 6]; 4]> {
         match (self, ws) {
             (Plate::ThreeSurfaceLayers(p), PlateWs::ThreeSurfaceLayers(w)) => Some(p.stresses_at(e, k, x3, v, w)),
             (Plate::FourSurfaceLayers(p), PlateWs::FourSurfaceLayers(w)) => Some(p.stresses_at(e, k, x3, v, w)),
             (Plate::FiveSurfaceLayers(p), PlateWs::FiveSurfaceLayers(w)) => Some(p.stresses_at(e, k, x3, v, w)),
+            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => Some(p.stresses_at(e, x3, v, w)),
+            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => Some(p.stresses_at(e, x3, v, w)),
+            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => Some(p.stresses_at(e, x3, v, w)),
             _ => None,
         }
     }

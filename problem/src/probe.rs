@@ -115,6 +115,23 @@ impl<'a> CellLocator<'a> {
         (f(0), f(1))
     }
 
+    /// Every cell that holds `p` (one inside a cell, two on an edge, all of a node's cells at a
+    /// node) with the local coordinates there; empty outside the mesh.
+    pub fn locate_all(&self, p: [f64; 2]) -> Vec<(usize, [f64; 2])> {
+        if self.locate(p).is_none() {
+            return Vec::new();
+        }
+        let (i, j) = self.bin(p);
+        self.bins[j * self.n[0] + i]
+            .iter()
+            .filter_map(|&c| {
+                let c = c as usize;
+                let xi = inverse_bilinear(&self.mesh.cell_coords(c), p)?;
+                (xi[0].abs().max(xi[1].abs()) - 1.0 <= INSIDE_TOL).then_some((c, xi))
+            })
+            .collect()
+    }
+
     /// The cell containing `p` and the local coordinates there; None outside the mesh.
     pub fn locate(&self, p: [f64; 2]) -> Option<(usize, [f64; 2])> {
         let tol = 1e-9 * (self.step[0] + self.step[1]);

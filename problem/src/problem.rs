@@ -456,6 +456,10 @@ pub struct ThicknessProbeSpec {
     pub at: [f64; 2],
     #[serde(default)]
     pub points_per_layer: Option<usize>,
+    /// `"law"` (default): s13, s23 by each layer's 3D law; `"equilibrium"`: integrated from the
+    /// bottom face (equilibrium_shear.rs).
+    #[serde(default)]
+    pub transverse_shear: Option<String>,
 }
 
 /// Names, points and counts, with file, line and key; a laminate is needed.
@@ -464,8 +468,13 @@ pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>
     for (i, s) in probes.iter().enumerate() {
         let spec = s.get_ref();
         let key = format!("output.thickness_probe[{i}]");
-        if p.spec.plate.get_ref().layers.is_none() {
-            return Err(p.error_at(s.span(), &key, "the stresses through the thickness are those of a laminate's layers: the plate needs `layers`"));
+        let plate = p.spec.plate.get_ref();
+        if plate.layers.is_none() && plate.surfaces() < 3 {
+            return Err(p.error_at(
+                s.span(),
+                &key,
+                "the stresses through the thickness are those of the 3D law: the plate needs `layers` or `surfaces` = 3 to 5 (the two-surface plate has the paper's plane-stress law)",
+            ));
         }
         let name = &spec.name;
         if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
@@ -476,6 +485,11 @@ pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>
         }
         if spec.at.iter().any(|v| !v.is_finite()) {
             return Err(p.error_at(s.span(), &format!("{key}.at"), format!("must be two finite numbers, got {:?}", spec.at)));
+        }
+        if let Some(t) = &spec.transverse_shear {
+            if t != "law" && t != "equilibrium" {
+                return Err(p.error_at(s.span(), &format!("{key}.transverse_shear"), format!("expected \"law\" or \"equilibrium\", got {}", stamp::quote(t))));
+            }
         }
         if let Some(n) = spec.points_per_layer {
             if !(2..=1000).contains(&n) {

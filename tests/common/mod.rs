@@ -113,6 +113,7 @@ pub fn bending_stiffness(h: f64) -> f64 {
     2.0e5 * h * h * h / (12.0 * (1.0 - 0.09))
 }
 
+pub mod cylindrical;
 pub mod pagano;
 pub mod sphere;
 
