@@ -1,6 +1,7 @@
 //! Newton backs off from states the problem refuses ([`StampError::Inadmissible`], e.g. a plate
 //! element turned inside out): the line search halves a refused trial, and without a line search
-//! the load step is cut back. A one-unknown problem whose full Newton step from the start lands
+//! the refused iterate's correction is halved back towards the last admissible one; only a
+//! refused start (nothing to halve) cuts the load step back. A one-unknown problem whose full Newton step from the start lands
 //! outside its admissible half-line: R(u, t) = ln u - (1 - t) ln 3 on u > 0, the root 3^(1-t);
 //! from u = 3 at t = 1 the Newton step goes to 3 - 3 ln 3 = -0.30.
 
@@ -68,8 +69,19 @@ fn the_line_search_halves_a_refused_trial() {
 }
 
 #[test]
-fn without_a_line_search_the_load_step_is_cut_back() {
+fn without_a_line_search_the_refused_correction_is_halved_not_cut_back() {
     let (u, refused, cutbacks) = solve(0);
     assert!((u - 1.0).abs() < 1e-9, "u = {u}");
-    assert!(refused >= 1 && cutbacks >= 1, "refused {refused}, cut-backs {cutbacks}");
+    assert!(refused >= 1, "the full step must have been tried and refused");
+    assert_eq!(cutbacks, 0);
+}
+
+#[test]
+fn a_refused_start_is_cut_back_and_fails() {
+    let settings = NewtonSettings { initial_increment: 1.0, max_increment: 1.0, max_cutbacks: 3, ..NewtonSettings::default() };
+    let mut p = Log::new();
+    let mut u = [-1.0];
+    let e = NewtonRaphson::new(SparseLu::new(), settings).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| {}).err().expect("refused");
+    assert!(matches!(e, StampError::NoConvergence { cutbacks: 3, .. }), "{e}");
+    assert_eq!(p.refused, 4, "the start refused at each of the four attempts");
 }

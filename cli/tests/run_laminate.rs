@@ -441,3 +441,85 @@ fn equilibrium_transverse_shear_against_the_exact_solution() {
         assert!(eq[1] < 0.4 * eq[0], "{angles:?}: the integrated shear does not converge with the mesh: {eq:?}");
     }
 }
+
+/// Contact and a follower pressure on either face of a laminate: an unsymmetric [0/90] stack
+/// pressed from above (a sphere and a follower pressure on the top face, moving down) is the
+/// mirror image (x3 -> -x3) of the [90/0] stack pressed from below (the same on the bottom
+/// face, moving up): the same punch force, opposite, and the mirrored deflection at every step,
+/// to Newton's tolerance; and a face that does not hold the stack's own order differs.
+#[test]
+fn a_laminate_pressed_from_below_is_the_mirror_of_one_pressed_from_above() {
+    let dir = temp_dir("laminate-mirror");
+    let problem = |bottom_angle: f64, top_angle: f64, face: &str| {
+        let (z, dz) = if face == "top" { (200.5, -0.3) } else { (-200.5, 0.3) };
+        format!(
+            r#"[mesh]
+rectangle = {{ x = [0.0, 20.0], y = [0.0, 20.0], n = [6, 6] }}
+
+[[material]]
+name = "ply"
+E = [2.5e4, 1.0e3, 1.0e3]
+G = [500.0, 500.0, 200.0]
+nu = [0.25, 0.25, 0.25]
+
+[plate]
+layers = [{{ thickness = 0.5, material = "ply", angle = {bottom_angle} }}, {{ thickness = 0.5, material = "ply", angle = {top_angle} }}]
+surfaces = 3
+
+[[boundary]]
+group = "left"
+fix = ["symmetry_x1"]
+
+[[boundary]]
+group = "bottom"
+fix = ["symmetry_x2"]
+
+[[boundary]]
+group = "right"
+fix = ["simply_supported"]
+
+[[boundary]]
+group = "top"
+fix = ["simply_supported"]
+
+[[load]]
+type = "pressure"
+group = "all"
+pressure = "0.001*(1 + x1/20)"
+follower = true
+face = "{face}"
+
+[[punch]]
+name = "sphere"
+shape = "sphere"
+center = [0.0, 0.0, {z}]
+radius = 200.0
+motion = [0.0, 0.0, {dz}]
+face = "{face}"
+
+[solver]
+steps = 3
+rel_tol = 1e-11
+"#
+        )
+    };
+    let mut results = Vec::new();
+    for (name, text) in [("above", problem(0.0, 90.0, "top")), ("below", problem(90.0, 0.0, "bottom")), ("below-unmirrored", problem(0.0, 90.0, "bottom"))] {
+        let path = write(&dir, &format!("{name}.toml"), &text);
+        let out = dir.join(name);
+        stamp_cli::run::run(&path, Some(&out), true).unwrap();
+        let s = summary(&out);
+        let steps = s["steps"].as_array().unwrap().clone();
+        results.push(steps.iter().map(|st| (st["load_factor"].as_f64().unwrap(), st["punches"]["sphere"]["reaction"][2].as_f64().unwrap(), st["points"]["corner_ll"]["displacement"][2].as_f64().unwrap())).collect::<Vec<_>>());
+    }
+    assert_eq!(results[0].len(), results[1].len(), "the same steps");
+    for (a, b) in results[0].iter().zip(&results[1]) {
+        assert_eq!(a.0, b.0);
+        assert!(a.1 < 0.0 && b.1 > 0.0, "pressed down from above, up from below: {} {}", a.1, b.1);
+        assert!((a.1 + b.1).abs() <= 1e-7 * a.1.abs(), "force {} against {}", a.1, b.1);
+        assert!((a.2 + b.2).abs() <= 1e-7 * a.2.abs() && a.2 < 0.0, "deflection {} against {}", a.2, b.2);
+    }
+    // the stack's order matters: [0/90] from below is not the mirror of [0/90] from above
+    let (a, c) = (results[0].last().unwrap(), results[2].last().unwrap());
+    assert!((a.1 + c.1).abs() > 1e-5 * a.1.abs(), "force {} against {}", a.1, c.1);
+}
