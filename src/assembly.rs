@@ -121,7 +121,13 @@ pub struct Assembler {
 impl Assembler {
     /// Cut the elements of `element` into blocks and colour the blocks.
     pub fn new<E: Element>(element: &E, num_nodes: usize) -> Self {
-        let ne = element.num_elements();
+        Self::for_elements(element, num_nodes, (0..element.num_elements()).collect())
+    }
+
+    /// The same for some of the elements only (ascending; a process's share, see
+    /// [`crate::share`]): [`Assembler::assemble_elements`] then evaluates these alone.
+    pub fn for_elements<E: Element>(element: &E, num_nodes: usize, elements: Vec<usize>) -> Self {
+        let ne = elements.len();
         let len = block_len(ne);
         let blocks: Vec<Range<usize>> = (0..ne.div_ceil(len)).map(|b| b * len..((b + 1) * len).min(ne)).collect();
         let color = |order: &[usize]| {
@@ -131,13 +137,22 @@ impl Assembler {
                 }
             })
         };
-        let mut order: Vec<usize> = (0..ne).collect();
+        let mut order = elements;
         let mut colors = color(&order);
         if colors.len() > MAX_BLOCK_COLORS {
-            order = breadth_first_order(num_nodes, ne, |e| element.element_nodes(e).to_vec());
+            // the whole mesh's breadth-first order, restricted to these elements
+            let all = element.num_elements();
+            let mut mine = vec![false; all];
+            order.iter().for_each(|&e| mine[e] = true);
+            order = breadth_first_order(num_nodes, all, |e| element.element_nodes(e).to_vec()).into_iter().filter(|&e| mine[e]).collect();
             colors = color(&order);
         }
         Assembler { order, blocks, colors }
+    }
+
+    /// Number of elements this assembler evaluates.
+    pub fn num_elements(&self) -> usize {
+        self.order.len()
     }
 
     /// Number of colours of the blocks (for diagnostics).
@@ -164,11 +179,30 @@ impl Assembler {
         values: Option<&mut [f64]>,
         preconditioner: Option<&mut [f64]>,
     ) -> Result<f64> {
+        match self.assemble_elements(element, dofs, pattern, u, force, values, preconditioner) {
+            (energy, usize::MAX) => Ok(energy),
+            (_, refused) => Err(Self::refusal(element, dofs, u, refused)),
+        }
+    }
+
+    /// [`Assembler::assemble`] without the error: (the strain energy, the lowest-numbered element
+    /// that refused the state or `usize::MAX`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn assemble_elements<E: Element>(
+        &self,
+        element: &E,
+        dofs: &DofMap,
+        pattern: &SparsePattern,
+        u: &[f64],
+        force: &mut [f64],
+        values: Option<&mut [f64]>,
+        preconditioner: Option<&mut [f64]>,
+    ) -> (f64, usize) {
         let dpn = dofs.dofs_per_node();
         let npe = element.nodes_per_element();
         let nloc = dpn * npe;
         // below this many elements a fork-join costs more than it saves
-        let parallel = element.num_elements() >= PARALLEL_MIN_ELEMENTS && rayon::current_num_threads() > 1;
+        let parallel = self.order.len() >= PARALLEL_MIN_ELEMENTS && rayon::current_num_threads() > 1;
         force.fill(0.0);
         let with_tangent = values.is_some();
         let zeroed = |values: Option<&mut [f64]>| match values {
@@ -255,7 +289,7 @@ impl Assembler {
         });
         if !parallel {
             // one thread: the whole mesh in assembly order
-            (energy, refused) = run(&mut init(), 0..element.num_elements());
+            (energy, refused) = run(&mut init(), 0..self.order.len());
         } else {
             for color in &self.colors {
                 let (w, bad) = color
@@ -266,15 +300,19 @@ impl Assembler {
                 refused = refused.min(bad);
             }
         }
-        if refused == usize::MAX {
-            return Ok(energy);
-        }
-        // the reason, from the element itself
+        (energy, refused)
+    }
+
+    /// The error of element `refused`, which refused the state `u`: the reason from the element
+    /// itself ([`StampError::Inadmissible`]).
+    pub fn refusal<E: Element>(element: &E, dofs: &DofMap, u: &[f64], refused: usize) -> StampError {
+        let dpn = dofs.dofs_per_node();
+        let nloc = dpn * element.nodes_per_element();
         let mut local = LocalSystem::new(nloc);
         let ue: Vec<f64> = element.element_nodes(refused).iter().flat_map(|&n| (0..dpn).map(move |c| u[n * dpn + c])).collect();
         element.evaluate(refused, &ue, &mut element.new_workspace(), &mut local, false);
         let reason = local.inadmissible.unwrap_or_else(|| "refused (no reason given)".into());
-        Err(StampError::Inadmissible { element: refused, reason })
+        StampError::Inadmissible { element: refused, reason }
     }
 }
 

@@ -21,3 +21,4 @@ pub mod contact;
 pub mod follower;
 pub mod model;
 pub mod nonlinear;
+pub mod share;

@@ -16,6 +16,7 @@ use crate::element::Element;
 use crate::follower::DeformationDependentLoad;
 use crate::error::{Result, StampError};
 use crate::nonlinear::{Evaluation, NonlinearProblem};
+use crate::share::Share;
 use crate::linalg::sparse::SparsePattern;
 use faer::sparse::SparseColMatRef;
 use std::time::Instant;
@@ -69,6 +70,9 @@ pub struct Model<E: Element> {
     last_scale: f64,
     peak_scale: f64,
     pub timings: ModelTimings,
+    /// This process's share of a model evaluated by several (see [`crate::share`]); None: the
+    /// whole model.
+    share: Option<Share>,
 }
 
 impl<E: Element> Model<E> {
@@ -109,6 +113,7 @@ impl<E: Element> Model<E> {
             last_scale: 0.0,
             peak_scale: 0.0,
             timings: ModelTimings::default(),
+            share: None,
         })
     }
 
@@ -213,6 +218,27 @@ impl<E: Element> Model<E> {
         &self.pattern
     }
 
+    /// Evaluate only this process's share of the model from now on (see [`crate::share`]: its
+    /// elements, and the contact and displacement-dependent-load tangent rows of its nodes, with
+    /// the forces and energy summed over the processes); None: the whole model again.
+    pub fn set_share(&mut self, share: Option<Share>) -> Result<()> {
+        let (ne, nn) = (self.element.num_elements(), self.dofs.num_nodes());
+        self.assembler = match &share {
+            Some(s) => {
+                if s.elements.windows(2).any(|w| w[0] >= w[1]) || s.elements.last().is_some_and(|&e| e >= ne) {
+                    return Err(StampError::Problem(format!("a share's elements must ascend below {ne}")));
+                }
+                if s.owned_nodes.len() != nn {
+                    return Err(StampError::Problem(format!("a share owns {} nodes of a model of {nn}", s.owned_nodes.len())));
+                }
+                Assembler::for_elements(&self.element, nn, s.elements.clone())
+            }
+            None => Assembler::new(&self.element, nn),
+        };
+        self.share = share;
+        Ok(())
+    }
+
     /// Number of element colours of the parallel assembly.
     pub fn num_colors(&self) -> usize {
         self.assembler.num_colors()
@@ -238,6 +264,14 @@ impl<E: Element> Model<E> {
     }
 }
 
+/// Whether this process adds the tangent entry (row dof r, column dof c) of a contact or
+/// displacement-dependent load (all of them without a share): those of the rows of its own nodes,
+/// and those of the force-driven punches' rows and columns (dofs from `nd` on) everywhere, which
+/// the bordered solver reads whole on every process.
+fn owns_row(share: &Option<Share>, dofs_per_node: usize, nd: usize) -> impl Fn(usize, usize) -> bool + '_ {
+    move |r, c| r >= nd || c >= nd || share.as_ref().is_none_or(|s| s.owned_nodes[r / dofs_per_node])
+}
+
 impl<E: Element> NonlinearProblem for Model<E> {
     fn num_dofs(&self) -> usize {
         self.dofs.num_dofs() + self.num_drives()
@@ -259,7 +293,23 @@ impl<E: Element> NonlinearProblem for Model<E> {
         let start = Instant::now();
         let values = if with_tangent { Some(self.values.as_mut_slice()) } else { None };
         let preconditioner = if with_tangent && !self.preconditioner.is_empty() { Some(self.preconditioner.as_mut_slice()) } else { None };
-        self.energy = self.assembler.assemble(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values, preconditioner)?;
+        let (mut energy, mut refused) = self.assembler.assemble_elements(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values, preconditioner);
+        if let Some(share) = &self.share {
+            // the lowest refusing element of any process, then the whole model's forces and energy
+            let mut r = [refused as u64];
+            share.reduce.min(&mut r)?;
+            refused = usize::try_from(r[0]).unwrap_or(usize::MAX);
+            if refused == usize::MAX {
+                share.reduce.sum(&mut self.force[..nd])?;
+                let mut e = [energy];
+                share.reduce.sum(&mut e)?;
+                energy = e[0];
+            }
+        }
+        if refused != usize::MAX {
+            return Err(Assembler::refusal(&self.element, &self.dofs, u, refused));
+        }
+        self.energy = energy;
         self.force[nd..].fill(0.0);
         let internal_norm = self.force.iter().map(|x| x * x).sum::<f64>().sqrt();
         let t_contact = Instant::now();
@@ -274,8 +324,12 @@ impl<E: Element> NonlinearProblem for Model<E> {
             let values = &mut self.values;
             let preconditioner = &mut self.preconditioner;
             let eq = |d: usize| if d < nd { dofs.equation(d) } else { Some(neq + d - nd) };
+            let mine = owns_row(&self.share, dofs.dofs_per_node(), nd);
             // the contact stiffness is symmetric: it belongs to the preconditioner as it is
             let mut add = |r: usize, c: usize, v: f64| {
+                if !mine(r, c) {
+                    return;
+                }
                 if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
                     if let Some(s) = pattern.find(re, ce) {
                         values[s] += v;
@@ -304,8 +358,12 @@ impl<E: Element> NonlinearProblem for Model<E> {
             let pattern = &self.pattern;
             let dofs = &self.dofs;
             let values = &mut self.values;
+            let mine = owns_row(&self.share, dofs.dofs_per_node(), nd);
             // R gets -t F, K gets -t dF/du (not symmetric: kept out of the preconditioner)
             let mut add = |r: usize, c: usize, v: f64| {
+                if !mine(r, c) {
+                    return;
+                }
                 if let (Some(re), Some(ce)) = (dofs.equation(r), dofs.equation(c)) {
                     if let Some(s) = pattern.find(re, ce) {
                         values[s] -= t * v;

@@ -11,6 +11,7 @@
 //! - [`supernodal_solve`]: the triangular solves with a supernodal LDL^T factor, scheduled on the
 //!   elimination tree so that independent subtrees run in parallel.
 //! - [`ordering`]: nested-dissection fill-reducing ordering (METIS on the nodal graph).
+//! - [`partition`]: the elements split into parts for processes (METIS's k-way partition).
 //! - [`bordered`]: [`BorderedSolver`](bordered::BorderedSolver), a sparse matrix bordered by a few
 //!   dense rows and columns (the unknown punch displacement of a force-controlled step), solved
 //!   by block elimination around any inner solver.
@@ -24,6 +25,7 @@ pub mod gmres;
 pub mod ldlt_gmres;
 pub mod linear_solver;
 pub mod ordering;
+pub mod partition;
 pub mod sparse;
 pub mod supernodal_solve;
 pub mod vector_state;

@@ -19,7 +19,7 @@ use std::sync::Mutex;
 
 /// METIS keeps its random number generator in global (not thread-local) state, reseeded at each
 /// call: calls are serialised, which also makes the orderings deterministic.
-static METIS: Mutex<()> = Mutex::new(());
+pub(crate) static METIS: Mutex<()> = Mutex::new(());
 
 /// Supervariables of a symmetric pattern: unknowns with the same closed neighbourhood
 /// adj(i) + {i}.

@@ -1,0 +1,188 @@
+//! A model evaluated by several processes, each its own share (stamp::share): three threads stand
+//! for three processes, with a reduction over them. At a large-displacement state with points in
+//! contact with a force-driven punch and a follower pressure, every share's residual, energy and
+//! contact state are the whole model's, the shares' tangents and preconditioners add up to the
+//! whole model's in the nodal block, and the punch's row and column are whole in every share. An
+//! element that refuses the state on one share gives every share the same error.
+
+mod common;
+use common::*;
+use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive};
+use stamp::dofs::DofMap;
+use stamp::error::Result;
+use stamp::linalg::partition::{node_owners, partition_elements};
+use stamp::mesh::QuadMesh;
+use stamp::model::Model;
+use stamp::nonlinear::NonlinearProblem;
+use stamp::share::{Reduce, Share};
+use stamp_contact::Sphere;
+use stamp_elements::{Face, FollowerPressure, Kinematics, PlateElements};
+use std::sync::{Arc, Barrier, Mutex};
+
+/// Sums and minima over `n` threads: each adds its entries into a common buffer, all wait, all
+/// read the result, all wait again before the next reduction.
+struct Threads {
+    barrier: Barrier,
+    sum: Mutex<Vec<f64>>,
+    min: Mutex<Vec<u64>>,
+}
+
+impl Reduce for Threads {
+    fn sum(&self, v: &mut [f64]) -> Result<()> {
+        {
+            let mut acc = self.sum.lock().unwrap();
+            if acc.is_empty() {
+                acc.extend_from_slice(v);
+            } else {
+                acc.iter_mut().zip(v.iter()).for_each(|(a, b)| *a += b);
+            }
+        }
+        self.barrier.wait();
+        v.copy_from_slice(&self.sum.lock().unwrap());
+        if self.barrier.wait().is_leader() {
+            self.sum.lock().unwrap().clear();
+        }
+        self.barrier.wait();
+        Ok(())
+    }
+    fn min(&self, v: &mut [u64]) -> Result<()> {
+        {
+            let mut acc = self.min.lock().unwrap();
+            if acc.is_empty() {
+                acc.extend_from_slice(v);
+            } else {
+                acc.iter_mut().zip(v.iter()).for_each(|(a, b)| *a = (*a).min(*b));
+            }
+        }
+        self.barrier.wait();
+        v.copy_from_slice(&self.min.lock().unwrap());
+        if self.barrier.wait().is_leader() {
+            self.min.lock().unwrap().clear();
+        }
+        self.barrier.wait();
+        Ok(())
+    }
+}
+
+const PARTS: usize = 3;
+
+fn model(mesh: &QuadMesh) -> Model<PlateElements> {
+    let section = steel_section(0.2);
+    let dp = section.delta_plus;
+    let plate = PlateElements::new(mesh, section, Kinematics::Nonlinear).unwrap();
+    let mut dofs = DofMap::new(mesh.num_nodes(), 6).unwrap();
+    dofs.fix(mesh.group_nodes("left").unwrap(), &[0, 1, 2, 3, 4, 5]).unwrap();
+    let mut model = Model::new(plate, dofs).unwrap();
+    let areas = mesh.nodal_areas();
+    let points = (0..mesh.num_nodes())
+        .map(|n| ContactPoint { node: n, x_ref: [mesh.coords[n][0], mesh.coords[n][1], dp], dofs: [0, 1, 2].map(|c| Face::Top.dof(n, c)), weight: areas[n] })
+        .collect();
+    let mut pair = ContactPair::new("punch", Arc::new(Sphere::new(nalgebra::Vector3::new(1.2, 1.1, 0.1 + 1.0), 1.0).unwrap()), points, 3.0e3, ContactKinematics::Exact);
+    pair.entry_fraction = 0.0;
+    pair.drive = Some(ForceDrive::new([0.0, 0.0, -1.0], 7.0).unwrap());
+    model.add_contact(pair);
+    model.add_follower_load(Box::new(FollowerPressure::new("pressure", &mesh.coords, &mesh.cells, Face::Bottom, -0.1, 40.0)));
+    model.want_preconditioner(true);
+    model
+}
+
+/// (residual, energy, active flags, tangent values, preconditioner values) at `u`, or the error.
+type Outcome = std::result::Result<(Vec<f64>, f64, Vec<bool>, Vec<f64>, Vec<f64>), String>;
+
+fn evaluate(model: &mut Model<PlateElements>, u: &[f64]) -> Outcome {
+    model.evaluate(u, 1.0, true).map_err(|e| e.to_string())?;
+    let active = model.contacts[0].state.iter().map(|s| s.active).collect();
+    Ok((model.residual().to_vec(), model.energy(), active, model.matrix().val().to_vec(), model.preconditioner().unwrap().val().to_vec()))
+}
+
+fn shared(mesh: &QuadMesh, u: &[f64]) -> Vec<Outcome> {
+    let cells = |e: usize| mesh.cells[e].to_vec();
+    let part = partition_elements(mesh.num_nodes(), mesh.num_cells(), cells, PARTS).unwrap();
+    let owner = node_owners(mesh.num_nodes(), mesh.num_cells(), cells, &part);
+    let reduce = Arc::new(Threads { barrier: Barrier::new(PARTS), sum: Mutex::new(Vec::new()), min: Mutex::new(Vec::new()) });
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..PARTS as u32)
+            .map(|k| {
+                let share = Share {
+                    elements: (0..mesh.num_cells()).filter(|&e| part[e] == k).collect(),
+                    owned_nodes: owner.iter().map(|&o| o == k).collect(),
+                    reduce: reduce.clone(),
+                };
+                s.spawn(move || {
+                    let mut m = model(mesh);
+                    m.set_share(Some(share)).unwrap();
+                    evaluate(&mut m, u)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
+}
+
+#[test]
+fn shares_add_up_to_the_whole_model() {
+    let mesh = QuadMesh::rectangle(0.0, 2.4, 0.0, 2.2, 8, 7).unwrap();
+    let mut whole = model(&mesh);
+    let n = whole.num_dofs();
+    let mut rng = Lcg(7);
+    // a sag under the punch, small random in-plane motion; the punch's unknown s = 0.12
+    let mut u = vec![0.0; n];
+    for k in 0..mesh.num_nodes() {
+        let [x, y] = mesh.coords[k];
+        let w = -0.08 * (x / 2.4) * (1.0 - ((x - 1.2).powi(2) + (y - 1.1).powi(2)) / 3.0);
+        for face in [Face::Top, Face::Bottom] {
+            u[face.dof(k, 2)] = w;
+            u[face.dof(k, 0)] = rng.range(-1e-3, 1e-3) * x;
+            u[face.dof(k, 1)] = rng.range(-1e-3, 1e-3) * x;
+        }
+    }
+    u[n - 1] = 0.12;
+    whole.apply_prescribed(&mut u, 1.0);
+    let (r, energy, active, k, p) = evaluate(&mut whole, &u).unwrap();
+    assert!(active.iter().filter(|a| **a).count() >= 3, "points in contact: {}", active.iter().filter(|a| **a).count());
+    let scale = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let kscale = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let outcomes = shared(&mesh, &u);
+    let (mut ks, mut ps) = (vec![0.0; k.len()], vec![0.0; p.len()]);
+    let neq = whole.num_equations();
+    let pattern = whole.pattern();
+    for (i, o) in outcomes.iter().enumerate() {
+        let (ri, ei, ai, ki, pi) = o.as_ref().unwrap();
+        let dr = r.iter().zip(ri).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(dr <= 1e-12 * scale, "share {i}: residual differs by {dr:e} of {scale:e}");
+        assert!((ei - energy).abs() <= 1e-12 * energy.abs(), "share {i}: energy {ei} against {energy}");
+        assert_eq!(ai, &active, "share {i}: active set");
+        ks.iter_mut().zip(ki).for_each(|(s, v)| *s += v);
+        ps.iter_mut().zip(pi).for_each(|(s, v)| *s += v);
+        // the punch's row and column are whole in every share
+        let border = neq - 1;
+        for j in 0..neq {
+            for (a, b) in [(border, j), (j, border)] {
+                if let Some(slot) = pattern.find(a, b) {
+                    assert_eq!(ki[slot], k[slot], "share {i}: entry ({a}, {b}) of the punch's row or column");
+                }
+            }
+        }
+    }
+    // the nodal block: the sum of the shares (the border counted once)
+    let border = neq - 1;
+    for j in 0..neq {
+        for i in 0..neq {
+            if let Some(slot) = pattern.find(i, j) {
+                let (sum_k, sum_p) = if i == border || j == border { (ks[slot] / PARTS as f64, ps[slot] / PARTS as f64) } else { (ks[slot], ps[slot]) };
+                assert!((sum_k - k[slot]).abs() <= 1e-12 * kscale, "tangent ({i}, {j}): shares add to {sum_k}, whole {}", k[slot]);
+                assert!((sum_p - p[slot]).abs() <= 1e-12 * kscale, "preconditioner ({i}, {j}): shares add to {sum_p}, whole {}", p[slot]);
+            }
+        }
+    }
+    // an element turned inside out on one share: the same error everywhere
+    let mut bad = u.clone();
+    let corner = mesh.cells[mesh.num_cells() - 1][2];
+    for face in [Face::Top, Face::Bottom] {
+        bad[face.dof(corner, 0)] = -3.0;
+    }
+    let want = evaluate(&mut whole, &bad).expect_err("an element refuses");
+    for (i, o) in shared(&mesh, &bad).iter().enumerate() {
+        assert_eq!(o.as_ref().expect_err("refused on every share"), &want, "share {i}");
+    }
+}
