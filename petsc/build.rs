@@ -33,6 +33,7 @@ const FUNCTIONS: &[&str] = &[
     "VecScatterDestroy",
     "MatCreateAIJ",
     "MatSetValues",
+    "MatZeroEntries",
     "MatAssemblyBegin",
     "MatAssemblyEnd",
     "MatSetOption",

@@ -45,6 +45,12 @@ struct Setup {
     key: (usize, usize, u64),
     /// Position in the compressed-column value array of each entry of this rank's rows.
     src: Vec<usize>,
+    /// PETSc's row (and column) of each of stamp's equations.
+    perm: Vec<usize>,
+    /// stamp's equations of this rank's rows, in PETSc's order.
+    own: Vec<usize>,
+    /// A full-length vector in PETSc's order (the gathered solution).
+    full: Vec<f64>,
     values: Vec<f64>,
     a: AijMatrix,
     p: Option<AijMatrix>,
@@ -67,12 +73,14 @@ pub struct PetscSolver {
     near_null: Vec<Vec<f64>>,
     timings: SolverTimings,
     iterations: usize,
+    /// The rank owning each equation, when the matrices are shared ([`PetscSolver::set_partition`]).
+    partition: Option<Vec<u32>>,
 }
 
 impl PetscSolver {
     /// The default scheme on PETSc, which must be initialised (every rank the same).
     pub fn new(petsc: &Petsc) -> Self {
-        PetscSolver { petsc: petsc.clone(), options: String::new(), setup: None, factored: false, near_null: Vec::new(), timings: SolverTimings::default(), iterations: 0 }
+        PetscSolver { petsc: petsc.clone(), options: String::new(), setup: None, factored: false, near_null: Vec::new(), timings: SolverTimings::default(), iterations: 0, partition: None }
     }
 
     /// The default scheme with PETSc options on top ("-ksp_type cg -pc_type gamg"), inserted into
@@ -92,6 +100,18 @@ impl PetscSolver {
     /// multigrid (`-pc_type gamg`) builds its coarse spaces. Taken at the next new pattern.
     pub fn set_near_null_space(&mut self, vectors: Vec<Vec<f64>>) {
         self.near_null = vectors;
+        self.setup = None;
+        self.factored = false;
+    }
+
+    /// From now on each rank hands over its share of the matrices, which PETSc sums (a model
+    /// evaluated by its share of the elements on each rank, see `stamp::share`): `owners[i]`, the
+    /// rank owning equation i (equations from `owners.len()` on: rank 0), whose rows PETSc keeps
+    /// on that rank (numbered rank after rank). Every rank passes the same owners; the right-hand
+    /// sides stay whole on every rank, and so do the solutions. None: every rank hands over the
+    /// whole matrices, split by rows evenly.
+    pub fn set_partition(&mut self, owners: Option<Vec<u32>>) {
+        self.partition = owners;
         self.setup = None;
         self.factored = false;
     }
@@ -119,23 +139,49 @@ impl PetscSolver {
         self.petsc.agree(local).map_err(StampError::LinearSolver)
     }
 
-    /// This rank's rows of an n-row matrix: an even split by index.
-    fn rows(&self, n: usize) -> (usize, usize) {
-        let (r, p) = (self.petsc.rank(), self.petsc.size());
-        (n * r / p, n * (r + 1) / p)
+    /// The rank owning each of n equations: [`PetscSolver::set_partition`]'s, else an even
+    /// split by index.
+    fn owners(&self, n: usize) -> std::result::Result<Vec<usize>, PetscError> {
+        let p = self.petsc.size();
+        match &self.partition {
+            Some(o) => (0..n)
+                .map(|i| {
+                    let r = o.get(i).map_or(0, |&r| r as usize);
+                    if r < p { Ok(r) } else { Err(PetscError::new(format!("equation {i} is given to rank {r} of {p}"))) }
+                })
+                .collect(),
+            None => Ok((0..p).flat_map(|r| std::iter::repeat_n(r, n * (r + 1) / p - n * r / p)).collect()),
+        }
     }
 
     /// Build the distributed matrices and the solver for the pattern of `a`.
     fn analyse(&mut self, a: SparseColMatRef<'_, usize, f64>, with_p: bool, key: (usize, usize, u64)) -> std::result::Result<Setup, PetscError> {
         let n = a.nrows();
-        let (lo, hi) = self.rows(n);
+        let owner = self.owners(n)?;
+        // PETSc's numbering: the equations of rank 0, then those of rank 1, ... each in stamp's order
+        let mut start = vec![0usize; self.petsc.size() + 1];
+        owner.iter().for_each(|&r| start[r + 1] += 1);
+        for r in 0..self.petsc.size() {
+            start[r + 1] += start[r];
+        }
+        let mut next = start.clone();
+        let perm: Vec<usize> = owner
+            .iter()
+            .map(|&r| {
+                next[r] += 1;
+                next[r] - 1
+            })
+            .collect();
+        let rank = self.petsc.rank();
+        let (lo, hi) = (start[rank], start[rank + 1]);
+        let own: Vec<usize> = (0..n).filter(|&i| owner[i] == rank).collect();
         let sym = a.symbolic();
         let (cp, ri) = (sym.col_ptr(), sym.row_idx());
-        // this rank's rows, compressed by rows: the transpose of the columns' entries in lo..hi
+        // this rank's rows, compressed by rows: the transpose of the columns' entries in its rows
         let mut count = vec![0usize; hi - lo + 1];
         for &i in ri {
-            if (lo..hi).contains(&i) {
-                count[i - lo + 1] += 1;
+            if owner[i] == rank {
+                count[perm[i] - lo + 1] += 1;
             }
         }
         for k in 0..hi - lo {
@@ -144,19 +190,23 @@ impl PetscSolver {
         let row_ptr = count.clone();
         let mut fill = count;
         let nnz = row_ptr[hi - lo];
-        let mut cols = vec![0; nnz];
-        let mut src = vec![0usize; nnz];
+        let mut entries = vec![(0usize, 0usize); nnz];
         for j in 0..n {
             for p in cp[j]..cp[j + 1] {
                 let i = ri[p];
-                if (lo..hi).contains(&i) {
-                    let slot = fill[i - lo];
-                    cols[slot] = pint(j)?;
-                    src[slot] = p;
-                    fill[i - lo] += 1;
+                if owner[i] == rank {
+                    let slot = &mut fill[perm[i] - lo];
+                    entries[*slot] = (perm[j], p);
+                    *slot += 1;
                 }
             }
         }
+        // columns ascending within each row (they are already, unless the numbering permutes)
+        for k in 0..hi - lo {
+            entries[row_ptr[k]..row_ptr[k + 1]].sort_unstable();
+        }
+        let cols = entries.iter().map(|&(c, _)| pint(c)).collect::<std::result::Result<Vec<_>, _>>()?;
+        let src: Vec<usize> = entries.into_iter().map(|(_, p)| p).collect();
         let pattern = RowPattern { lo, hi, n, row_ptr, cols };
         let am = AijMatrix::new(&self.petsc, pattern.clone())?;
         let mut pm = if with_p {
@@ -170,22 +220,31 @@ impl PetscSolver {
             if let Some(bad) = self.near_null.iter().find(|v| v.len() != n) {
                 return Err(PetscError::new(format!("a near-null vector has {} entries for a matrix of {n} rows", bad.len())));
             }
-            let local: Vec<Vec<f64>> = self.near_null.iter().map(|v| v[lo..hi].to_vec()).collect();
+            let local: Vec<Vec<f64>> = self.near_null.iter().map(|v| own.iter().map(|&i| v[i]).collect()).collect();
             match pm.as_mut() {
                 Some(pm) => pm.set_near_null_space(&self.petsc, &local)?,
                 None => {
                     // the preconditioner is built from A
                     let mut am = am;
                     am.set_near_null_space(&self.petsc, &local)?;
-                    return self.finish(am, None, src, key, n, lo, hi);
+                    return self.finish(am, None, src, key, perm, own);
                 }
             }
         }
-        self.finish(am, pm, src, key, n, lo, hi)
+        self.finish(am, pm, src, key, perm, own)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn finish(&self, a: AijMatrix, p: Option<AijMatrix>, src: Vec<usize>, key: (usize, usize, u64), n: usize, lo: usize, hi: usize) -> std::result::Result<Setup, PetscError> {
+    fn finish(&self, mut a: AijMatrix, mut p: Option<AijMatrix>, src: Vec<usize>, key: (usize, usize, u64), perm: Vec<usize>, own: Vec<usize>) -> std::result::Result<Setup, PetscError> {
+        let n = perm.len();
+        if self.partition.is_some() {
+            // the whole pattern of this rank's rows, in zeros: the nonzero structure every later
+            // sum of shares keeps (shares add only their nonzero entries)
+            let zeros = vec![0.0; src.len()];
+            a.set_values(&zeros)?;
+            if let Some(p) = p.as_mut() {
+                p.set_values(&zeros)?;
+            }
+        }
         let mut ksp = Ksp::new(&self.petsc)?;
         ksp.set_operators(&a, p.as_ref().unwrap_or(&a))?;
         ksp.set_type("gmres")?;
@@ -200,11 +259,13 @@ impl PetscSolver {
             ksp.set_right_preconditioning()?;
         }
         let tolerances = ksp.tolerances()?;
-        let b = DVec::new(&self.petsc, hi - lo, n)?;
-        let x = DVec::new(&self.petsc, hi - lo, n)?;
+        let b = DVec::new(&self.petsc, own.len(), n)?;
+        let x = DVec::new(&self.petsc, own.len(), n)?;
         let gather = Gather::new(&self.petsc, &x)?;
+        // (shared matrices are added by columns: no map from this rank's rows)
+        let src = if self.partition.is_some() { Vec::new() } else { src };
         let values = vec![0.0; src.len()];
-        Ok(Setup { key, src, values, a, p, ksp, b, x, gather, tolerances })
+        Ok(Setup { key, src, perm, own, full: vec![0.0; n], values, a, p, ksp, b, x, gather, tolerances })
     }
 
     fn factorize_local(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> std::result::Result<(), PetscError> {
@@ -229,12 +290,22 @@ impl PetscSolver {
         }
         let t = Instant::now();
         let s = self.setup.as_mut().unwrap();
-        let fill = |values: &mut Vec<f64>, src: &[usize], from: &[f64]| values.iter_mut().zip(src).for_each(|(v, &k)| *v = from[k]);
-        fill(&mut s.values, &s.src, a.val());
-        s.a.set_values(&s.values)?;
-        if let (Some(pm), Some(p)) = (s.p.as_mut(), p) {
-            fill(&mut s.values, &s.src, p.val());
-            pm.set_values(&s.values)?;
+        if self.partition.is_some() {
+            // each rank's share, summed by PETSc
+            let sym = a.symbolic();
+            s.a.set_sum_of_columns(sym.col_ptr(), sym.row_idx(), a.val(), &s.perm)?;
+            if let (Some(pm), Some(p)) = (s.p.as_mut(), p) {
+                pm.set_sum_of_columns(sym.col_ptr(), sym.row_idx(), p.val(), &s.perm)?;
+            }
+        } else {
+            // the whole matrices on every rank: this rank's rows
+            let fill = |values: &mut Vec<f64>, src: &[usize], from: &[f64]| values.iter_mut().zip(src).for_each(|(v, &k)| *v = from[k]);
+            fill(&mut s.values, &s.src, a.val());
+            s.a.set_values(&s.values)?;
+            if let (Some(pm), Some(p)) = (s.p.as_mut(), p) {
+                fill(&mut s.values, &s.src, p.val());
+                pm.set_values(&s.values)?;
+            }
         }
         // the same matrices again: PETSc rebuilds the preconditioner, keeping its symbolic phase
         s.ksp.set_operators(&s.a, s.p.as_ref().unwrap_or(&s.a))?;
@@ -260,9 +331,11 @@ impl PetscSolver {
         let t = Instant::now();
         let (base, atol, max_it) = s.tolerances;
         s.ksp.set_tolerances(rtol.max(base), atol, max_it)?;
-        s.b.set_from_full(b)?;
+        let own = &s.own;
+        s.b.with_local_mut(|x| x.iter_mut().zip(own).for_each(|(x, &i)| *x = b[i]))?;
         let report = s.ksp.solve(&s.b, &mut s.x)?;
-        s.gather.gather(&s.x, b)?;
+        s.gather.gather(&s.x, &mut s.full)?;
+        b.iter_mut().zip(&s.perm).for_each(|(x, &k)| *x = s.full[k]);
         self.iterations += report.iterations;
         self.timings.solve += t.elapsed().as_secs_f64();
         self.timings.solves += 1;

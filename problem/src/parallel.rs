@@ -58,6 +58,77 @@ pub fn any_rank(flag: bool) -> bool {
     flag
 }
 
+/// On P > 1 ranks, share the model over them (see `stamp::share`): METIS splits the elements
+/// into P parts, each rank evaluates only its own, and each node (its equations, its contact and
+/// follower-load tangent rows) belongs to the rank of the lowest-numbered element around it; the
+/// linear solver is told the same owners, so that each rank's rows of the distributed matrices are
+/// mostly its own elements' entries. On one rank, or without the feature `petsc`: nothing.
+pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, linear: &mut Linear) -> Result<()> {
+    #[cfg(not(feature = "petsc"))]
+    {
+        let _ = (model, linear);
+        Ok(())
+    }
+    #[cfg(feature = "petsc")]
+    {
+        use stamp::linalg::partition::{node_owners, partition_elements};
+        let Some(petsc) = stamp_petsc::Petsc::current() else { return Ok(()) };
+        let (p, rank) = (petsc.size(), petsc.rank());
+        if p <= 1 {
+            return Ok(());
+        }
+        let (ne, nn) = (model.element.num_elements(), model.dofs.num_nodes());
+        let element = &model.element;
+        let nodes = |e: usize| element.element_nodes(e).to_vec();
+        let part = partition_elements(nn, ne, nodes, p)?;
+        // METIS is deterministic: every rank computed the same parts (checked, since a rank that
+        // disagreed would wait for ever in a collective call)
+        let h = part.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &x| (h ^ x as u64).wrapping_mul(0x0100_0000_01b3));
+        let (mut hi, mut lo) = ([h], [h]);
+        petsc.max_u64(&mut hi)?;
+        petsc.min_u64(&mut lo)?;
+        if hi != lo {
+            return Err(stamp::StampError::Problem("the ranks partitioned the mesh differently".into()));
+        }
+        let owner = node_owners(nn, ne, nodes, &part);
+        let dpn = model.dofs.dofs_per_node();
+        let mut equation_owner = vec![0u32; model.dofs.num_equations()];
+        for (dof, &eq) in model.dofs.equations().iter().enumerate() {
+            if eq != stamp::dofs::PRESCRIBED {
+                equation_owner[eq as usize] = owner[dof / dpn];
+            }
+        }
+        let r = rank as u32;
+        let share = stamp::share::Share {
+            elements: (0..ne).filter(|&e| part[e] == r).collect(),
+            owned_nodes: owner.iter().map(|&o| o == r).collect(),
+            reduce: std::sync::Arc::new(MpiReduce(petsc)),
+        };
+        model.set_share(Some(share))?;
+        linear.set_partition(Some(equation_owner));
+        Ok(())
+    }
+}
+
+/// Sums and minima over the ranks (MPI_Allreduce on PETSc's communicator); a sum is then
+/// broadcast from rank 0, so that every rank holds the same bits whatever order MPI added in.
+#[cfg(feature = "petsc")]
+struct MpiReduce(stamp_petsc::Petsc);
+
+#[cfg(feature = "petsc")]
+impl stamp::share::Reduce for MpiReduce {
+    fn sum(&self, v: &mut [f64]) -> Result<()> {
+        self.0.sum_f64(v)?;
+        // SAFETY: any f64 is 8 plain bytes; the byte view lives only for the broadcast
+        let bytes = unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<u8>(), std::mem::size_of_val(v)) };
+        self.0.broadcast(bytes, 0)?;
+        Ok(())
+    }
+    fn min(&self, v: &mut [u64]) -> Result<()> {
+        Ok(self.0.min_u64(v)?)
+    }
+}
+
 /// `[solver] petsc_options` is for a stamp built with the feature `petsc`: an error at the key
 /// without it.
 pub fn check_options(p: &Problem) -> Result<()> {

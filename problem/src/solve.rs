@@ -355,12 +355,14 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
 
     // the linear solver (PETSc's under the feature `petsc`, see parallel.rs)
     let ranks = super::parallel::ranks();
-    let linear = {
+    let mut linear = {
         let layout = Layout::of(&model.element);
         let z = |c: usize| section.delta_minus + (layout.zeta_of_component(c) + 1.0) / 2.0 * section.thickness();
         let inner = model.num_equations() - model.num_drives();
         super::parallel::linear_solver(p, &mesh.mesh.coords, model.dofs.equations(), model.dofs.dofs_per_node(), inner, z)?
     };
+    // on P > 1 ranks each evaluates its own elements (see parallel.rs)
+    super::parallel::share(&mut model, &mut linear)?;
     let mut summary = Summary {
         ranks,
         linear_solver: super::parallel::describe(&linear),
