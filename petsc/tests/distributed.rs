@@ -14,6 +14,10 @@
 //!   without the rigid-body near-null space, and with the default GMRES + MUMPS.
 //! - `unsymmetric`: convection-diffusion A preconditioned by the Laplacian P (today's scheme:
 //!   GMRES on A, MUMPS LDL^T of P), against a manufactured solution and faer's LU of A.
+//! - `shared`: the same A and P handed over in shares ([`PetscSolver::set_partition`]): each
+//!   rank passes its own part of every entry (zeros elsewhere in the common pattern), the rows
+//!   owned in scattered blocks; the sum's solution is faer's LU of the whole A, the same on every
+//!   rank, twice with other values (no share left over from the first).
 //! - `failures`: a Krylov solve that does not converge, an option PETSc does not know, a singular
 //!   matrix and a failure on one rank only: each an error on every rank, the same message.
 
@@ -123,6 +127,20 @@ fn unsymmetric_gmres_preconditioned_by_mumps_ldlt_on_1_2_4_ranks() {
 }
 
 #[test]
+fn shares_of_the_matrices_summed_on_1_2_4_ranks() {
+    for ranks in [1, 2, 4] {
+        let lines = run("shared", ranks);
+        for m in &lines {
+            let (first, second) = (num(m, "difference_from_faer"), num(m, "second_difference_from_faer"));
+            assert!(first < 1e-9 && second < 1e-9, "{ranks} ranks: from faer's LU {first:e}, after new values {second:e}");
+            assert!((2.0..=40.0).contains(&num(m, "iterations")), "{ranks} ranks: {} GMRES iterations", m["iterations"]);
+        }
+        let bits: Vec<&String> = lines.iter().map(|m| &m["solution_bits"]).collect();
+        assert!(bits.windows(2).all(|w| w[0] == w[1]), "{ranks} ranks: the gathered solutions differ: {bits:?}");
+    }
+}
+
+#[test]
 fn failures_are_errors_on_every_rank_with_one_message() {
     for ranks in [1, 2, 4] {
         let lines = run("failures", ranks);
@@ -160,6 +178,7 @@ fn child() {
         "elasticity" => elasticity(&petsc),
         "unsymmetric" => unsymmetric(&petsc),
         "failures" => failures(&petsc),
+        "shared" => shared(&petsc),
         other => panic!("no case {other}"),
     };
     let line: Vec<String> = fields.iter().map(|(k, v)| format!("{k}={v}")).collect();
@@ -400,6 +419,62 @@ fn unsymmetric(petsc: &Petsc) -> Vec<(String, String)> {
         ("iterations".into(), (s.iterations() / 2).to_string()),
         ("solver".into(), s.describe()),
     ]
+}
+
+/// 1D convection-diffusion on n points: A = -u'' + c u' (centred) and P = -u'', as triplets.
+fn convection_diffusion(n: usize, conv: f64) -> (Vec<(usize, usize, f64)>, Vec<(usize, usize, f64)>) {
+    let h = 1.0 / (n + 1) as f64;
+    let (mut ta, mut tp) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        ta.push((i, i, 2.0 / (h * h)));
+        tp.push((i, i, 2.0 / (h * h)));
+        if i > 0 {
+            ta.push((i, i - 1, -1.0 / (h * h) - conv / (2.0 * h)));
+            tp.push((i, i - 1, -1.0 / (h * h)));
+        }
+        if i + 1 < n {
+            ta.push((i, i + 1, -1.0 / (h * h) + conv / (2.0 * h)));
+            tp.push((i, i + 1, -1.0 / (h * h)));
+        }
+    }
+    (ta, tp)
+}
+
+fn shared(petsc: &Petsc) -> Vec<(String, String)> {
+    let n = 3000;
+    let (rank, size) = (petsc.rank(), petsc.size());
+    let (ta, tp) = convection_diffusion(n, 20.0);
+    // this rank's share of each entry: the off-diagonal entries whole on rank (i + j) % size,
+    // the diagonal in equal parts on every rank; zeros keep the common pattern
+    let share = |t: &[(usize, usize, f64)]| -> Vec<(usize, usize, f64)> {
+        t.iter().map(|&(i, j, v)| (i, j, if i == j { v / size as f64 } else if (i + j) % size == rank { v } else { 0.0 })).collect()
+    };
+    // equations owned in blocks of 7, dealt round the ranks in turn
+    let owners: Vec<u32> = (0..n).map(|i| ((i / 7) % size) as u32).collect();
+    let b: Vec<f64> = (0..n).map(|i| ((i + 1) as f64 * 0.01).sin()).collect();
+    let mut s = PetscSolver::new(petsc);
+    s.set_partition(Some(owners));
+    let mut lu = SparseLu::new();
+    let max = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut out = Vec::new();
+    for (round, scale) in [(0, 1.0), (1, 3.0)] {
+        let scaled = |t: &[(usize, usize, f64)]| -> Vec<(usize, usize, f64)> { t.iter().map(|&(i, j, v)| (i, j, if i == j { v * scale } else { v })).collect() };
+        let (a, p) = (scaled(&ta), scaled(&tp));
+        s.factorize_preconditioned(csc(n, &share(&a)).as_ref(), Some(csc(n, &share(&p)).as_ref())).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        lu.factorize(csc(n, &a).as_ref()).unwrap();
+        let mut y = b.clone();
+        lu.solve_in_place(&mut y).unwrap();
+        let key = if round == 0 { "difference_from_faer" } else { "second_difference_from_faer" };
+        out.push((key.to_string(), format!("{:e}", max(&x, &y))));
+        if round == 1 {
+            let bits = x.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, v| (h ^ v.to_bits()).wrapping_mul(0x0100_0000_01b3));
+            out.push(("solution_bits".into(), format!("{bits:x}")));
+        }
+    }
+    out.push(("iterations".into(), (s.iterations() / 2).to_string()));
+    out
 }
 
 fn failures(petsc: &Petsc) -> Vec<(String, String)> {
