@@ -31,7 +31,7 @@ stamp=target/release/stamp
 
 # sphere-clamped is compared at 1e-5: its first step converges with |R| at 5e-9 of the force
 # scale, and the peak pressure there differs by 1.2e-6 between the faer and the PETSc iterates
-quick="sphere-ss sphere-ss-displacement paper-r100 stl-die squeeze sphere-clamped ellipsoid-expression sphere-slide"
+quick="sphere-ss sphere-ss-displacement paper-r100 stl-die squeeze sphere-clamped ellipsoid-expression sphere-slide cantilever-roll"
 for f in meshes/*.toml; do
   name=$(basename "$f" .toml)
   # the laminate (13 surfaces, 40 x 40: 34 s with faer, minutes on PETSc) would take a third of

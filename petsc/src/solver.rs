@@ -1,13 +1,17 @@
 //! [`PetscSolver`]: stamp's [`LinearSolver`] on PETSc, for `mpirun -n P`.
 //!
-//! What is distributed and what is not: every rank is handed the whole matrix (stamp's
+//! Two ways to hand over the matrices. By default every rank is handed the whole matrix (stamp's
 //! compressed-column tangent, assembled on every rank) and copies only its own contiguous range
-//! of rows into a distributed MPIAIJ matrix (rows split evenly by index), so the factorisation
-//! (MUMPS), the Krylov iterations and their memory are spread over the ranks while the model and
-//! its assembly are replicated. The solution is gathered onto every rank, so that every rank
-//! goes on with the same iterate; a hash of every right-hand side is compared over the ranks, so
-//! that ranks whose replicated states drifted apart stop with an error instead of waiting on each
-//! other.
+//! of rows (split evenly by index) into a distributed MPIAIJ matrix. After
+//! [`PetscSolver::set_partition`] each rank is handed only its share (a model evaluated by its own
+//! elements on each rank, `stamp::share`): PETSc's rows are numbered rank after rank by the owner
+//! of each equation, every rank adds the nonzero entries of its share (`ADD_VALUES`: PETSc sends
+//! those of other ranks' rows at the assembly) into the full pattern, which is allocated once and
+//! kept, so MUMPS keeps its symbolic factorisation. Either way the factorisation (MUMPS), the
+//! Krylov iterations and their memory are spread over the ranks, and the solution is gathered
+//! onto every rank, so that every rank goes on with the same iterate; a hash of every
+//! right-hand side is compared over the ranks, so that ranks whose replicated states drifted
+//! apart stop with an error instead of waiting on each other.
 //!
 //! The default scheme is stamp's own (`LdltGmres`): restarted GMRES (40 vectors, at most 200
 //! iterations, preconditioned from the right so that it judges the true residual) on the tangent

@@ -7,13 +7,24 @@
 //! preconditioned by MUMPS's LDL^T of the plate's P, the scheme of [`LdltGmres`]; `[solver]
 //! petsc_options` on top, with the rigid-body modes as the near-null space for GAMG).
 //!
-//! What is distributed: the tangent, by rows, and its factorisation and solves. What is
-//! replicated: every rank reads the problem, builds the whole model and assembles the whole
-//! tangent and residual, and runs the same Newton iterations on the gathered solution; so the
-//! active sets, the augmented-Lagrangian updates, the line search and every convergence test are
-//! the same on every rank by construction (PetscSolver checks that the right-hand sides agree to
-//! the bit). A failure in the solve is agreed over the ranks; one in writing (rank 0 only) stops
-//! every rank after the step ([`any_rank`]).
+//! What is distributed ([`share`], on P > 1 ranks): METIS splits the mesh's elements into P
+//! parts and each rank evaluates only its own elements (internal forces, tangent, the plate's P);
+//! the forces and the energy are summed over the ranks (MPI) right after, so every rank holds the
+//! whole residual. Each node belongs to the rank of the lowest-numbered element around it: that
+//! rank adds the node's contact and follower-load tangent rows, and PETSc keeps the node's rows of
+//! the distributed matrices there, so each rank's share of the tangent goes mostly into its own
+//! rows (PETSc adds the shares: `stamp_petsc::PetscSolver::set_partition`). MUMPS's factorisation
+//! and the Krylov iterations are distributed too.
+//!
+//! What is replicated: every rank reads the problem and holds the whole mesh, model, sparse
+//! pattern and value arrays (zeros outside its share); the contact search and the
+//! follower loads are evaluated on every rank (their states -- active sets, multipliers -- are the
+//! same everywhere by construction), and every rank runs the same Newton iterations on the
+//! gathered solution; so the active sets, the augmented-Lagrangian updates, the line search and
+//! every convergence test are the same on every rank (PetscSolver checks that the right-hand sides
+//! agree to the bit). The outputs are computed on every rank, written by rank 0. A failure in the
+//! solve is agreed over the ranks; one in writing (rank 0 only) stops every rank after the step
+//! ([`any_rank`]).
 
 use crate::problem::Problem;
 use stamp::Result;
