@@ -8,9 +8,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$SECONDS
-if ! pkg-config --exists PETSc 2>/dev/null || ! command -v mpirun >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/libclang*.so* >/dev/null 2>&1; then
+# OpenBLAS: Debian's PETSc links libblas.so.3, which is the reference BLAS unless an optimised one
+# is installed; MUMPS's factorisations are 3 times slower on it (docs/parallel.md)
+if ! pkg-config --exists PETSc 2>/dev/null || ! command -v mpirun >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/libclang*.so* >/dev/null 2>&1 || ! ls /usr/lib/x86_64-linux-gnu/openblas-pthread/libblas.so.3 >/dev/null 2>&1; then
   apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libpetsc-real-dev openmpi-bin libopenmpi-dev libclang-dev pkg-config >/dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libpetsc-real-dev openmpi-bin libopenmpi-dev libclang-dev pkg-config libopenblas0-pthread >/dev/null
 fi
 export OMP_NUM_THREADS=1
 mpirun=(mpirun --oversubscribe)
