@@ -73,7 +73,8 @@ pub fn any_rank(flag: bool) -> bool {
 /// into P parts, each rank evaluates only its own, and each node (its equations, its contact and
 /// follower-load tangent rows) belongs to the rank of the lowest-numbered element around it; the
 /// linear solver is told the same owners, so that each rank's rows of the distributed matrices are
-/// mostly its own elements' entries. On one rank, or without the feature `petsc`: nothing.
+/// mostly its own elements' entries. On one rank, with fewer elements than ranks, or without the
+/// feature `petsc`: nothing (every rank evaluates the whole model).
 pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, linear: &mut Linear) -> Result<()> {
     #[cfg(not(feature = "petsc"))]
     {
@@ -89,6 +90,10 @@ pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, lin
             return Ok(());
         }
         let (ne, nn) = (model.element.num_elements(), model.dofs.num_nodes());
+        if ne < p {
+            // fewer elements than ranks: every rank evaluates the whole model
+            return Ok(());
+        }
         let element = &model.element;
         let nodes = |e: usize| element.element_nodes(e).to_vec();
         let part = partition_elements(nn, ne, nodes, p)?;
