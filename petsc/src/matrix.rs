@@ -112,32 +112,25 @@ impl AijMatrix {
         check(unsafe { ffi::MatAssemblyEnd(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY) })
     }
 
-    /// Set the matrix to the sum over the ranks of each rank's sparse matrix, given by compressed
-    /// columns (`col_ptr`, `row_idx`, `values`, in stamp's numbering; `perm[i]`: PETSc's row and
-    /// column of stamp's i), and assemble (collective). Each rank adds only its nonzero entries;
-    /// PETSc sends those of other ranks' rows at the assembly. Every entry must lie in the
-    /// pattern of the rows it falls in (the preallocation is the pattern's): the pattern and
-    /// its nonzero structure stay, so a factorisation keeps its symbolic phase.
-    pub fn set_sum_of_columns(&mut self, col_ptr: &[usize], row_idx: &[usize], values: &[f64], perm: &[usize]) -> Result<()> {
-        if col_ptr.len() != perm.len() + 1 || values.len() != row_idx.len() || col_ptr.last() != Some(&row_idx.len()) {
-            return Err(PetscError::new(format!("{} columns, {} entries and {} values for a permutation of {}", col_ptr.len().saturating_sub(1), row_idx.len(), values.len(), perm.len())));
-        }
+    /// Set the matrix to the sum over the ranks of each rank's share, and assemble
+    /// (collective): `own(k)`, this rank's share of entry k of its own rows (in the pattern's
+    /// order); `foreign`,
+    /// the entries it holds in other ranks' rows, (row, column, value), which PETSc sends at the
+    /// assembly. Every entry must lie in the pattern (the preallocation is the pattern's): the
+    /// nonzero structure stays, so a factorisation keeps its symbolic phase.
+    pub fn set_sum(&mut self, own: impl Fn(usize) -> f64, foreign: &[(ffi::PetscInt, ffi::PetscInt, f64)]) -> Result<()> {
+        let p = &self.pattern;
         check(unsafe { ffi::MatZeroEntries(self.raw) })?;
-        let (mut rows, mut vals): (Vec<ffi::PetscInt>, Vec<f64>) = (Vec::new(), Vec::new());
-        for j in 0..perm.len() {
-            rows.clear();
-            vals.clear();
-            for p in col_ptr[j]..col_ptr[j + 1] {
-                if values[p] != 0.0 {
-                    rows.push(pint(perm[row_idx[p]])?);
-                    vals.push(values[p]);
-                }
-            }
-            if !rows.is_empty() {
-                let col = pint(perm[j])?;
-                // an m x 1 block: row- and column-major alike
-                check(unsafe { ffi::MatSetValues(self.raw, pint(rows.len())?, rows.as_ptr(), 1, &col, vals.as_ptr(), ffi::InsertMode_ADD_VALUES) })?;
-            }
+        let mut row_values = Vec::new();
+        for i in 0..p.hi - p.lo {
+            let (a, b) = (p.row_ptr[i], p.row_ptr[i + 1]);
+            let row = pint(p.lo + i)?;
+            row_values.clear();
+            row_values.extend((a..b).map(&own));
+            check(unsafe { ffi::MatSetValues(self.raw, 1, &row, pint(b - a)?, p.cols[a..b].as_ptr(), row_values.as_ptr(), ffi::InsertMode_ADD_VALUES) })?;
+        }
+        for &(i, j, v) in foreign {
+            check(unsafe { ffi::MatSetValues(self.raw, 1, &i, 1, &j, &v, ffi::InsertMode_ADD_VALUES) })?;
         }
         check(unsafe { ffi::MatAssemblyBegin(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY) })?;
         check(unsafe { ffi::MatAssemblyEnd(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY) })

@@ -29,6 +29,7 @@
 use crate::error::PetscError;
 use crate::ksp::Ksp;
 use crate::matrix::{AijMatrix, RowPattern};
+use crate::ffi::PetscInt as pint_t;
 use crate::petsc::{pint, Petsc};
 use crate::vector::{DVec, Gather};
 use faer::sparse::SparseColMatRef;
@@ -56,6 +57,8 @@ struct Setup {
     /// A full-length vector in PETSc's order (the gathered solution).
     full: Vec<f64>,
     values: Vec<f64>,
+    /// A share's nonzero entries in other ranks' rows, (PETSc row, column, value) (scratch).
+    foreign: Vec<(pint_t, pint_t, f64)>,
     a: AijMatrix,
     p: Option<AijMatrix>,
     ksp: Ksp,
@@ -266,10 +269,9 @@ impl PetscSolver {
         let b = DVec::new(&self.petsc, own.len(), n)?;
         let x = DVec::new(&self.petsc, own.len(), n)?;
         let gather = Gather::new(&self.petsc, &x)?;
-        // (shared matrices are added by columns: no map from this rank's rows)
-        let src = if self.partition.is_some() { Vec::new() } else { src };
-        let values = vec![0.0; src.len()];
-        Ok(Setup { key, src, perm, own, full: vec![0.0; n], values, a, p, ksp, b, x, gather, tolerances })
+        // (shares are added row by row from the map: no copy of the values)
+        let values = if self.partition.is_some() { Vec::new() } else { vec![0.0; src.len()] };
+        Ok(Setup { key, src, perm, own, full: vec![0.0; n], values, foreign: Vec::new(), a, p, ksp, b, x, gather, tolerances })
     }
 
     fn factorize_local(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> std::result::Result<(), PetscError> {
@@ -295,11 +297,30 @@ impl PetscSolver {
         let t = Instant::now();
         let s = self.setup.as_mut().unwrap();
         if self.partition.is_some() {
-            // each rank's share, summed by PETSc
+            // each rank's share, summed by PETSc: its own rows through the map, its nonzero
+            // entries in other ranks' rows sent
             let sym = a.symbolic();
-            s.a.set_sum_of_columns(sym.col_ptr(), sym.row_idx(), a.val(), &s.perm)?;
+            let (cp, ri) = (sym.col_ptr(), sym.row_idx());
+            let (lo, hi) = (s.b.ownership_range()?.0, s.b.ownership_range()?.1);
+            let foreign = |out: &mut Vec<(pint_t, pint_t, f64)>, val: &[f64]| -> std::result::Result<(), PetscError> {
+                out.clear();
+                for j in 0..cp.len() - 1 {
+                    for k in cp[j]..cp[j + 1] {
+                        let i = s.perm[ri[k]];
+                        if (i < lo || i >= hi) && val[k] != 0.0 {
+                            out.push((pint(i)?, pint(s.perm[j])?, val[k]));
+                        }
+                    }
+                }
+                Ok(())
+            };
+            foreign(&mut s.foreign, a.val())?;
+            let (src, val) = (&s.src, a.val());
+            s.a.set_sum(|k| val[src[k]], &s.foreign)?;
             if let (Some(pm), Some(p)) = (s.p.as_mut(), p) {
-                pm.set_sum_of_columns(sym.col_ptr(), sym.row_idx(), p.val(), &s.perm)?;
+                foreign(&mut s.foreign, p.val())?;
+                let val = p.val();
+                pm.set_sum(|k| val[src[k]], &s.foreign)?;
             }
         } else {
             // the whole matrices on every rank: this rank's rows
