@@ -246,8 +246,10 @@ class Result:
         return self._r.contact_pressure(name, self._step(step))
 
     def cell_data(self, step=-1):
-        """The .vtu's cell arrays as a dict of (m,) float64 arrays: the membrane forces N11, N22,
-        N12, moments M11, M22, M12, shear forces Q1, Q2 and T33 at the cell centres."""
+        """The .vtu's cell arrays as a dict of float64 arrays: the membrane forces N11, N22, N12,
+        moments M11, M22, M12, shear forces Q1, Q2 and T33 at the cell centres ((m,) each); with
+        three or more surfaces (or layers) also ``stress_layer<L>_surface<S>``, the six 3D
+        stresses s11, s22, s33, s12, s13, s23 at each surface of each layer ((m, 6))."""
         return self._r.cell_data(self._step(step))
 
     def point_data(self, step=-1):

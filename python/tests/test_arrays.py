@@ -32,7 +32,12 @@ def test_shapes_and_dtypes(request, which, surfaces):
         assert q.shape == (n,) and q.dtype == np.float64 and q.min() >= 0.0
     cells = r.cell_data()
     assert list(cells) == r.summary["cell_arrays"]
-    assert all(v.shape == (m,) and v.dtype == np.float64 for v in cells.values())
+    assert all(v.dtype == np.float64 for v in cells.values())
+    stresses = [k for k in cells if k.startswith("stress_")]
+    assert all(cells[k].shape == (m, 6) for k in stresses), "the six 3D stresses per cell"
+    assert all(v.shape == (m,) for k, v in cells.items() if k not in stresses)
+    # the six 3D stresses at every surface for plates of three or more surfaces
+    assert stresses == ([f"stress_layer0_surface{s}" for s in range(surfaces)] if surfaces > 2 else [])
     points = r.point_data()
     assert list(points) == r.summary["point_arrays"]
     assert points["displacement"].shape == (n, 3) and points["lambda"].shape == (n,)
