@@ -85,7 +85,8 @@ pub fn node_owners(num_nodes: usize, num_elements: usize, element_nodes: impl Fn
 mod tests {
     use super::*;
 
-    fn grid(nx: usize, ny: usize) -> impl Fn(usize) -> Vec<usize> {
+    /// The nodes of element e of a grid nx cells wide (numbered row by row, like its nodes).
+    fn grid(nx: usize) -> impl Fn(usize) -> Vec<usize> {
         move |e| {
             let (i, j) = (e % nx, e / nx);
             let n = j * (nx + 1) + i;
@@ -103,8 +104,8 @@ mod tests {
         let ne = nx * ny;
         let nn = (nx + 1) * (ny + 1);
         for parts in 1..=4 {
-            let p = partition_elements(nn, ne, grid(nx, ny), parts).unwrap();
-            assert_eq!(p, partition_elements(nn, ne, grid(nx, ny), parts).unwrap(), "{parts} parts: repeatable");
+            let p = partition_elements(nn, ne, grid(nx), parts).unwrap();
+            assert_eq!(p, partition_elements(nn, ne, grid(nx), parts).unwrap(), "{parts} parts: repeatable");
             let mut size = vec![0usize; parts];
             p.iter().for_each(|&k| size[k as usize] += 1);
             for s in &size {
@@ -124,11 +125,11 @@ mod tests {
                 }
             }
             assert!(cut <= 3 * nx * (parts - 1), "{parts} parts: {cut} cut edges");
-            let owners = node_owners(nn, ne, grid(nx, ny), &p);
+            let owners = node_owners(nn, ne, grid(nx), &p);
             for (n, &o) in owners.iter().enumerate() {
-                assert!((0..ne).any(|e| p[e] == o && grid(nx, ny)(e).contains(&n)), "node {n} owned by part {o}, which has no element of it");
+                assert!((0..ne).any(|e| p[e] == o && grid(nx)(e).contains(&n)), "node {n} owned by part {o}, which has no element of it");
             }
         }
-        assert!(partition_elements(nn, 3, grid(nx, ny), 4).is_err());
+        assert!(partition_elements(nn, 3, grid(nx), 4).is_err());
     }
 }
