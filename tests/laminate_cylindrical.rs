@@ -152,7 +152,7 @@ fn exact_solution_is_3d_elasticity() {
         let ex = Cylindrical::new(stack(angles, 1.0), a, 1.0);
         let d = 1e-4;
         for &(x, z) in &[(0.3, -0.3), (1.1, -0.05), (1.7, 0.2), (2.9, 0.45)] {
-            let k = ex.layer_at(z);
+            let k = ex.stack.layer_at(z);
             let du = |i: usize, dx: f64, dz: f64| (ex.displacement(x + dx, z + dz)[i] - ex.displacement(x - dx, z - dz)[i]) / (2.0 * d);
             let e = [du(0, d, 0.0), 0.0, du(2, 0.0, d), du(1, 0.0, d), du(0, 0.0, d) + du(2, d, 0.0), du(1, d, 0.0)];
             let c = &ex.layers[k].c;

@@ -23,8 +23,8 @@
 //! tests/common/pagano.rs). For a ply at 0 or 90 degrees V = Y = 0 (Pagano 1969); at other angles
 //! u2 and s23 couple in (Pagano 1970).
 
-use super::pagano::{Layer, Stiffness};
-use nalgebra::{Matrix6, Vector6};
+use super::pagano::{Layer, Stiffness, ThroughThickness};
+use nalgebra::Matrix6;
 
 /// The exact solution for the load s33 = q0 sin(pi x1 / a) on the top face (upwards for q0 > 0),
 /// layers from the bottom up, the mid-plane at z = 0.
@@ -32,10 +32,8 @@ pub struct Cylindrical {
     pub layers: Vec<Layer>,
     pub a: f64,
     pub q0: f64,
-    /// z of the layer boundaries.
-    pub z: Vec<f64>,
-    start: Vec<Vector6<f64>>,
-    system: Vec<Matrix6<f64>>,
+    /// The state through the layers.
+    pub stack: ThroughThickness,
 }
 
 /// The rows over S of W' and of the in-plane stresses [s11, s22, s12] (amplitudes of sin px).
@@ -75,40 +73,13 @@ fn system(c: &Stiffness, p: f64) -> Matrix6<f64> {
 impl Cylindrical {
     pub fn new(layers: Vec<Layer>, a: f64, q0: f64) -> Cylindrical {
         let p = std::f64::consts::PI / a;
-        let h: f64 = layers.iter().map(|l| l.thickness).sum();
-        let mut z = vec![-0.5 * h];
-        for l in &layers {
-            z.push(z.last().unwrap() + l.thickness);
-        }
-        let system: Vec<Matrix6<f64>> = layers.iter().map(|l| system(&l.c, p)).collect();
-        let mut t = Matrix6::identity();
-        for (l, m) in layers.iter().zip(&system) {
-            t = (m * l.thickness).exp() * t;
-        }
-        let k = t.fixed_view::<3, 3>(3, 0).into_owned();
-        let u0 = k.lu().solve(&nalgebra::Vector3::new(0.0, 0.0, q0)).expect("a regular plate");
-        let mut s = Vector6::new(u0[0], u0[1], u0[2], 0.0, 0.0, 0.0);
-        let mut start = Vec::new();
-        for (l, m) in layers.iter().zip(&system) {
-            start.push(s);
-            s = (m * l.thickness).exp() * s;
-        }
-        Cylindrical { layers, a, q0, z, start, system }
-    }
-
-    /// The state [U, V, W, X, Y, Z] at z in layer k.
-    pub fn state(&self, k: usize, z: f64) -> Vector6<f64> {
-        (self.system[k] * (z - self.z[k])).exp() * self.start[k]
-    }
-
-    /// The layer that holds z (the lower one at an interface).
-    pub fn layer_at(&self, z: f64) -> usize {
-        (0..self.layers.len()).find(|&k| z <= self.z[k + 1] + 1e-12 * self.a).unwrap_or(self.layers.len() - 1)
+        let stack = ThroughThickness::new(&layers, layers.iter().map(|l| system(&l.c, p)).collect(), q0, a);
+        Cylindrical { layers, a, q0, stack }
     }
 
     /// The displacement [u1, u2, u3] at (x, z).
     pub fn displacement(&self, x: f64, z: f64) -> [f64; 3] {
-        let s = self.state(self.layer_at(z), z);
+        let s = self.stack.state(self.stack.layer_at(z), z);
         let px = std::f64::consts::PI * x / self.a;
         [s[0] * px.cos(), s[1] * px.cos(), s[2] * px.sin()]
     }
@@ -116,7 +87,7 @@ impl Cylindrical {
     /// The stresses [s11, s22, s33, s23, s13, s12] at (x, z) in layer k.
     pub fn stress(&self, k: usize, x: f64, z: f64) -> [f64; 6] {
         let p = std::f64::consts::PI / self.a;
-        let s = self.state(k, z);
+        let s = self.stack.state(k, z);
         let (_, r) = rows(&self.layers[k].c, p);
         let amp = |row: &[f64; 6]| (0..6).map(|j| row[j] * s[j]).sum::<f64>();
         let (sn, cs) = ((p * x).sin(), (p * x).cos());

@@ -43,11 +43,57 @@ pub struct Pagano {
     pub a: f64,
     pub b: f64,
     pub q0: f64,
+    /// The state through the layers.
+    pub stack: ThroughThickness,
+}
+
+/// The state S(z) = [U, V, W, X, Y, Z] through a stack of layers whose equations are S' = A_k S
+/// in layer k (constant A_k: S = exp(A_k (z - z_k)) S(z_k)), continuous at the interfaces, with
+/// a traction-free bottom face (X = Y = Z = 0) and the top face loaded by X = Y = 0, Z = q0:
+/// S(top) = T S(bottom), T the product of the layers' exponentials, whose lower-left 3 x 3 block
+/// fixes U, V, W at the bottom. The mid-plane of the stack is at z = 0.
+pub struct ThroughThickness {
     /// z of the layer boundaries.
     pub z: Vec<f64>,
     /// The state at the bottom of each layer.
     start: Vec<Vector6<f64>>,
     system: Vec<Matrix6<f64>>,
+    /// A length of the plate: the round-off scale of z.
+    length: f64,
+}
+
+impl ThroughThickness {
+    pub fn new(layers: &[Layer], system: Vec<Matrix6<f64>>, q0: f64, length: f64) -> ThroughThickness {
+        let h: f64 = layers.iter().map(|l| l.thickness).sum();
+        let mut z = vec![-0.5 * h];
+        for l in layers {
+            z.push(z.last().unwrap() + l.thickness);
+        }
+        let mut t = Matrix6::identity();
+        for (l, m) in layers.iter().zip(&system) {
+            t = (m * l.thickness).exp() * t;
+        }
+        let k = t.fixed_view::<3, 3>(3, 0).into_owned();
+        let u0 = k.lu().solve(&nalgebra::Vector3::new(0.0, 0.0, q0)).expect("a regular plate");
+        let mut s = Vector6::new(u0[0], u0[1], u0[2], 0.0, 0.0, 0.0);
+        let mut start = Vec::new();
+        for (l, m) in layers.iter().zip(&system) {
+            start.push(s);
+            s = (m * l.thickness).exp() * s;
+        }
+        ThroughThickness { z, start, system, length }
+    }
+
+    /// The state [U, V, W, X, Y, Z] at z in layer k.
+    pub fn state(&self, k: usize, z: f64) -> Vector6<f64> {
+        (self.system[k] * (z - self.z[k])).exp() * self.start[k]
+    }
+
+    /// The layer that holds z (the lower one at an interface).
+    pub fn layer_at(&self, z: f64) -> usize {
+        let n = self.start.len();
+        (0..n).find(|&k| z <= self.z[k + 1] + 1e-12 * self.length).unwrap_or(n - 1)
+    }
 }
 
 fn system(c: &Stiffness, p: f64, q: f64) -> Matrix6<f64> {
@@ -84,41 +130,14 @@ fn system(c: &Stiffness, p: f64, q: f64) -> Matrix6<f64> {
 impl Pagano {
     pub fn new(layers: Vec<Layer>, a: f64, b: f64, q0: f64) -> Pagano {
         let (p, q) = (std::f64::consts::PI / a, std::f64::consts::PI / b);
-        let h: f64 = layers.iter().map(|l| l.thickness).sum();
-        let mut z = vec![-0.5 * h];
-        for l in &layers {
-            z.push(z.last().unwrap() + l.thickness);
-        }
-        let system: Vec<Matrix6<f64>> = layers.iter().map(|l| system(&l.c, p, q)).collect();
         // S(top) = T S(bottom), S(bottom) = [U, V, W, 0, 0, 0]
-        let mut t = Matrix6::identity();
-        for (l, m) in layers.iter().zip(&system) {
-            t = (m * l.thickness).exp() * t;
-        }
-        let k = t.fixed_view::<3, 3>(3, 0).into_owned();
-        let u0 = k.lu().solve(&nalgebra::Vector3::new(0.0, 0.0, q0)).expect("a regular plate");
-        let mut s = Vector6::new(u0[0], u0[1], u0[2], 0.0, 0.0, 0.0);
-        let mut start = Vec::new();
-        for (l, m) in layers.iter().zip(&system) {
-            start.push(s);
-            s = (m * l.thickness).exp() * s;
-        }
-        Pagano { layers, a, b, q0, z, start, system }
-    }
-
-    /// The state [U, V, W, X, Y, Z] at z in layer k.
-    pub fn state(&self, k: usize, z: f64) -> Vector6<f64> {
-        (self.system[k] * (z - self.z[k])).exp() * self.start[k]
-    }
-
-    /// The layer that holds z (the lower one at an interface).
-    pub fn layer_at(&self, z: f64) -> usize {
-        (0..self.layers.len()).find(|&k| z <= self.z[k + 1] + 1e-12 * self.a).unwrap_or(self.layers.len() - 1)
+        let stack = ThroughThickness::new(&layers, layers.iter().map(|l| system(&l.c, p, q)).collect(), q0, a);
+        Pagano { layers, a, b, q0, stack }
     }
 
     /// The displacement [u, v, w] at (x, y, z).
     pub fn displacement(&self, x: f64, y: f64, z: f64) -> [f64; 3] {
-        let s = self.state(self.layer_at(z), z);
+        let s = self.stack.state(self.stack.layer_at(z), z);
         let (px, qy) = (std::f64::consts::PI * x / self.a, std::f64::consts::PI * y / self.b);
         [s[0] * px.cos() * qy.sin(), s[1] * px.sin() * qy.cos(), s[2] * px.sin() * qy.sin()]
     }
@@ -126,7 +145,7 @@ impl Pagano {
     /// The stresses [s_xx, s_yy, s_zz, s_yz, s_xz, s_xy] at (x, y, z) in layer k.
     pub fn stress(&self, k: usize, x: f64, y: f64, z: f64) -> [f64; 6] {
         let (p, q) = (std::f64::consts::PI / self.a, std::f64::consts::PI / self.b);
-        let s = self.state(k, z);
+        let s = self.stack.state(k, z);
         let c = &self.layers[k].c;
         let wp = (s[5] + c[0][2] * p * s[0] + c[1][2] * q * s[1]) / c[2][2];
         let sxx = -c[0][0] * p * s[0] - c[0][1] * q * s[1] + c[0][2] * wp;
