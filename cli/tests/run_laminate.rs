@@ -83,6 +83,21 @@ fn pagano_general(angles: &[f64], sr: f64, n: usize, per_layer: usize) -> String
         )
 }
 
+/// Run the problem `text` as `<name>.toml` in `dir`; per step its load factor, the x3 reaction of
+/// the punch named "sphere" and the x3 displacement of the point group `corner_ll`.
+fn sphere_steps(dir: &std::path::Path, name: &str, text: &str) -> Vec<(f64, f64, f64)> {
+    let path = write(dir, &format!("{name}.toml"), text);
+    let out = dir.join(name);
+    stamp_cli::run::run(&path, Some(&out), true).unwrap();
+    let s = summary(&out);
+    s["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|st| (st["load_factor"].as_f64().unwrap(), st["punches"]["sphere"]["reaction"][2].as_f64().unwrap(), st["points"]["corner_ll"]["displacement"][2].as_f64().unwrap()))
+        .collect()
+}
+
 fn read_csv(path: &std::path::Path) -> Vec<Vec<f64>> {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
@@ -304,15 +319,7 @@ fn one_layer_runs_as_the_multi_surface_plate_with_contact_and_the_coarse_predict
         base.replace("thickness = 1.0\nE = 2.1e5\nnu = 0.3\n", "layers = [{ thickness = 1.0, material = \"steel\" }]\nsurfaces = 4\n")
     );
     assert!(layered.contains("layers") && plain.contains("surfaces = 4"));
-    let mut results = Vec::new();
-    for (name, text) in [("plain", &plain), ("layered", &layered)] {
-        let path = write(&dir, &format!("{name}.toml"), text);
-        let out = dir.join(name);
-        stamp_cli::run::run(&path, Some(&out), true).unwrap();
-        let s = summary(&out);
-        let steps = s["steps"].as_array().unwrap().clone();
-        results.push(steps.iter().map(|st| (st["load_factor"].as_f64().unwrap(), st["punches"]["sphere"]["reaction"][2].as_f64().unwrap(), st["points"]["corner_ll"]["displacement"][2].as_f64().unwrap())).collect::<Vec<_>>());
-    }
+    let results: Vec<_> = [("plain", &plain), ("layered", &layered)].into_iter().map(|(name, text)| sphere_steps(&dir, name, text)).collect();
     assert_eq!(results[0].len(), results[1].len(), "the same steps");
     for (a, b) in results[0].iter().zip(&results[1]) {
         assert_eq!(a.0, b.0);
@@ -503,15 +510,10 @@ rel_tol = 1e-11
 "#
         )
     };
-    let mut results = Vec::new();
-    for (name, text) in [("above", problem(0.0, 90.0, "top")), ("below", problem(90.0, 0.0, "bottom")), ("below-unmirrored", problem(0.0, 90.0, "bottom"))] {
-        let path = write(&dir, &format!("{name}.toml"), &text);
-        let out = dir.join(name);
-        stamp_cli::run::run(&path, Some(&out), true).unwrap();
-        let s = summary(&out);
-        let steps = s["steps"].as_array().unwrap().clone();
-        results.push(steps.iter().map(|st| (st["load_factor"].as_f64().unwrap(), st["punches"]["sphere"]["reaction"][2].as_f64().unwrap(), st["points"]["corner_ll"]["displacement"][2].as_f64().unwrap())).collect::<Vec<_>>());
-    }
+    let results: Vec<_> = [("above", problem(0.0, 90.0, "top")), ("below", problem(90.0, 0.0, "bottom")), ("below-unmirrored", problem(0.0, 90.0, "bottom"))]
+        .into_iter()
+        .map(|(name, text)| sphere_steps(&dir, name, &text))
+        .collect();
     assert_eq!(results[0].len(), results[1].len(), "the same steps");
     for (a, b) in results[0].iter().zip(&results[1]) {
         assert_eq!(a.0, b.0);
