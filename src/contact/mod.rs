@@ -270,10 +270,10 @@ impl SiteContext<'_> {
 /// through the punch at the next iterate (measured on a cylinder pressed across a plate of gmsh
 /// triangles: 128 of 134 points released at once, 3913 penetrating at the next iterate, and a
 /// torus-shaped die cut its steps back twice). Measured on every shipped example, the torus die
-/// and the README tutorial (docs/performance.md, "Newton iterations per step"): 0.05 removes the
+/// and the README tutorial (docs/performance.md, "Today: the shipped problems"): 0.05 removes the
 /// torus die's cut-backs and takes the paper's R = 100 strip from 153 + 25 failed to 122 Newton
-/// iterations, leaving the others within one iteration; 0.2 and 0.5 cost the sphere problems
-/// and the ellipsoid one to three more.
+/// iterations, leaving the others within one iteration; 0.2 and 0.5 cost ellipsoid-expression 4
+/// and 5 more and disk-clamped 1 and 15 more.
 pub const RELEASE_FRACTION: f64 = 0.05;
 
 /// The default [`ContactPair::entry_fraction`].
@@ -559,11 +559,11 @@ impl ContactPair {
         };
         // Damped release (see `release_fraction`): an active point whose trial turned tensile
         // leaves only where its trial is at least release_fraction times the most tensile one
-        let release_cut = if damped && self.release_fraction > 0.0 {
+        let release_cut = if damped && !first && self.release_fraction > 0.0 {
             let most = kin
                 .iter()
                 .enumerate()
-                .filter(|(k, _)| !first && self.last_active[*k] && !self.frozen[*k])
+                .filter(|(k, _)| self.last_active[*k] && !self.frozen[*k])
                 .map(|(k, q)| self.lambda_bar[k] + self.eps_reg * q.0)
                 .fold(0.0f64, f64::max);
             self.release_fraction * most
