@@ -179,7 +179,7 @@ impl Assembler {
         values: Option<&mut [f64]>,
         preconditioner: Option<&mut [f64]>,
     ) -> Result<f64> {
-        match self.assemble_elements(element, dofs, pattern, u, force, values, preconditioner) {
+        match self.assemble_elements(element, dofs, pattern, u, None, force, values, preconditioner) {
             (energy, usize::MAX) => Ok(energy),
             (_, refused) => Err(Self::refusal(element, dofs, u, refused)),
         }
@@ -194,6 +194,7 @@ impl Assembler {
         dofs: &DofMap,
         pattern: &SparsePattern,
         u: &[f64],
+        reference: Option<&[f64]>,
         force: &mut [f64],
         values: Option<&mut [f64]>,
         preconditioner: Option<&mut [f64]>,
@@ -226,12 +227,15 @@ impl Assembler {
         // (a worker thread may come from faer's kernels: see crate::linalg::vector_state)
         let init = || {
             crate::linalg::vector_state::clean_upper_vector_state();
-            (element.new_workspace(), local_system(), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc])
+            (element.new_workspace(), local_system(), vec![0.0; nloc], vec![0usize; nloc], vec![0u32; nloc], vec![0.0; nloc])
         };
-        // per-thread scratch: workspace, local system, local values, global dofs, row ranks
+        // the tangent's reference state (see Element::evaluate_about), for evaluations with one
+        let reference = reference.filter(|_| with_tangent);
+        // per-thread scratch: workspace, local system, local values, global dofs, row ranks, local
+        // reference values
         // per element: its energy, and its number if it refused the state (usize::MAX if not)
-        let kernel = |st: &mut (E::Workspace, LocalSystem, Vec<f64>, Vec<usize>, Vec<u32>), e: usize| -> (f64, usize) {
-                let (ws, local, ue, gdof, rank) = st;
+        let kernel = |st: &mut (E::Workspace, LocalSystem, Vec<f64>, Vec<usize>, Vec<u32>, Vec<f64>), e: usize| -> (f64, usize) {
+                let (ws, local, ue, gdof, rank, ue_ref) = st;
                 let nodes = element.element_nodes(e);
                 for (a, &n) in nodes.iter().enumerate() {
                     for c in 0..dpn {
@@ -240,7 +244,16 @@ impl Assembler {
                     }
                 }
                 local.clear(with_tangent);
-                element.evaluate(e, ue, ws, local, with_tangent);
+                if let Some(r) = reference {
+                    for (a, &n) in nodes.iter().enumerate() {
+                        for c in 0..dpn {
+                            ue_ref[a * dpn + c] = r[n * dpn + c];
+                        }
+                    }
+                    element.evaluate_about(e, ue, ue_ref, ws, local, with_tangent);
+                } else {
+                    element.evaluate(e, ue, ws, local, with_tangent);
+                }
                 if local.inadmissible.is_some() {
                     return (0.0, e);
                 }

@@ -73,6 +73,18 @@ pub struct Model<E: Element> {
     /// This process's share of a model evaluated by several (see [`crate::share`]); None: the
     /// whole model.
     share: Option<Share>,
+    /// The tangent's reference state (see [`Element::evaluate_about`]): the nodal dofs of the
+    /// last evaluation with a tangent, or of the last converged state at the start of a step;
+    /// empty: every tangent is the exact derivative at its iterate.
+    reference: Vec<f64>,
+    /// The nodal dofs of the last evaluation (the converged state's at a checkpoint).
+    last_u: Vec<f64>,
+    /// The nodal dofs of the last converged state.
+    converged_u: Vec<f64>,
+    /// Newton's tangent from the stresses linearised about the last iterate
+    /// ([`Element::evaluate_about`]: the mixed-integration-point Newton iteration); false (the
+    /// default): every tangent is the exact derivative of the residual at its iterate.
+    pub mixed_tangent: bool,
 }
 
 impl<E: Element> Model<E> {
@@ -114,6 +126,10 @@ impl<E: Element> Model<E> {
             peak_scale: 0.0,
             timings: ModelTimings::default(),
             share: None,
+            reference: Vec::new(),
+            last_u: Vec::new(),
+            converged_u: Vec::new(),
+            mixed_tangent: false,
         })
     }
 
@@ -293,7 +309,16 @@ impl<E: Element> NonlinearProblem for Model<E> {
         let start = Instant::now();
         let values = if with_tangent { Some(self.values.as_mut_slice()) } else { None };
         let preconditioner = if with_tangent && !self.preconditioner.is_empty() { Some(self.preconditioner.as_mut_slice()) } else { None };
-        let (mut energy, mut refused) = self.assembler.assemble_elements(&self.element, &self.dofs, &self.pattern, u, &mut self.force[..nd], values, preconditioner);
+        let reference = (with_tangent && self.mixed_tangent && self.reference.len() == nd).then_some(self.reference.as_slice());
+        let (mut energy, mut refused) = self.assembler.assemble_elements(&self.element, &self.dofs, &self.pattern, u, reference, &mut self.force[..nd], values, preconditioner);
+        if self.mixed_tangent {
+            self.last_u.clear();
+            self.last_u.extend_from_slice(&u[..nd]);
+            if with_tangent {
+                self.reference.clear();
+                self.reference.extend_from_slice(&u[..nd]);
+            }
+        }
         if let Some(share) = &self.share {
             // the lowest refusing element of any process, then the whole model's forces and energy
             let mut r = [refused as u64];
@@ -440,6 +465,7 @@ impl<E: Element> NonlinearProblem for Model<E> {
         self.contacts.iter_mut().map(|c| c.update_active_set()).sum()
     }
     fn start_step(&mut self, predicted: bool) {
+        self.reference.clone_from(&self.converged_u);
         for c in self.contacts.iter_mut() {
             c.start_step(predicted);
         }
@@ -456,6 +482,7 @@ impl<E: Element> NonlinearProblem for Model<E> {
         // called after a converged step (and once before the first): its last evaluation is the
         // converged state's
         self.peak_scale = self.peak_scale.max(self.last_scale);
+        self.converged_u.clone_from(&self.last_u);
         self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone(), c.last_active.clone())).collect();
     }
     fn restore(&mut self) {

@@ -30,9 +30,16 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed
     check_with(surface, kin, seed, drive, false)
 }
 
-/// `integrated`: the integrated discretisation (each node's weighted gap over its cells), whose
-/// tangent couples the nodes of neighbouring cells.
 fn check_with(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed: u64, drive: Option<[f64; 3]>, integrated: bool) {
+    let (mut model, u) = model_at(surface, kin, seed, drive, integrated, false);
+    check_model(&mut model, &u, drive.is_some());
+}
+
+/// A distorted 3 x 3 plate with a punch pressed into it at a random large-displacement state,
+/// evaluated once with the tangent. `integrated`: the integrated discretisation (each node's
+/// weighted gap over its cells), whose tangent couples the nodes of neighbouring cells;
+/// `gauss_newton`: the Gauss-Newton tangent of the points that enter at this (first) contact.
+fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics, seed: u64, drive: Option<[f64; 3]>, integrated: bool, gauss_newton: bool) -> (Model<PlateElements>, Vec<f64>) {
     let mut mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 3, 3).unwrap();
     // distort the interior nodes
     let mut rng = Lcg(seed);
@@ -62,8 +69,10 @@ fn check_with(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics,
         pair = pair.with_face(ContactFace::new(&mesh.coords, &mesh.cells, &all, mesh.num_nodes()).unwrap()).unwrap();
     }
     // every penetrating point active in the one evaluation (no damped entry, which starts an
-    // empty set at the deepest point only)
+    // empty set at the deepest point only), each with its exact tangent (no Gauss-Newton tangent
+    // for the points that enter: see the next test)
     pair.entry_fraction = 0.0;
+    pair.gauss_newton_entry = gauss_newton;
     pair.motion = [0.01, -0.02, -0.05].into();
     if let Some(n) = drive {
         pair.drive = Some(ForceDrive::new(n, 7.0).unwrap());
@@ -89,6 +98,12 @@ fn check_with(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics,
         model.evaluate(&u, 1.0, true).unwrap();
         assert!(!model.contacts[0].needs_coupling());
     }
+    (model, u)
+}
+
+/// The tangent of the model's last evaluation against central differences of its residual at `u`.
+fn check_model(model: &mut Model<PlateElements>, u: &[f64], drive: bool) {
+    let u = u.to_vec();
     let active = model.contacts[0].state.iter().filter(|s| s.active).count();
     assert!(active >= 3, "the test state should have points in contact, has {active}");
     let k = dense(model.matrix());
@@ -119,7 +134,7 @@ fn check_with(surface: Arc<dyn stamp::surface::ContactSurface>, kin: Kinematics,
         }
     }
     assert!(worst < 1e-6, "model tangent differs from finite differences by {worst:e}");
-    if drive.is_some() {
+    if drive {
         // the punch's row and column are really there (a tangent of zeros would pass above only if
         // the residual ignored s too)
         let s = neq - 1;
@@ -193,4 +208,41 @@ fn model_tangent_with_integrated_contact_matches_finite_differences() {
     check_with(Arc::new(s()), Kinematics::Linear, 33, Some([0.0, 0.0, -1.0]), true);
     let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
     check_with(Arc::new(c), Kinematics::Nonlinear, 34, None, true);
+}
+
+/// At the first contact every point enters: with `gauss_newton_entry` (the default) their
+/// tangent lacks the curvature term w lambda H (see stamp::contact::DEEP_ENTRY_RATIO), and
+/// nothing else differs; once they are in, the next evaluation at the same state gives the
+/// exact tangent again.
+#[test]
+fn points_entering_at_the_first_contact_get_the_gauss_newton_tangent() {
+    let centre = nalgebra::Vector3::new(1.0, 1.0, 1.2);
+    let sphere = || Arc::new(Sphere::new(centre, 1.5).unwrap());
+    let (exact, u) = model_at(sphere(), Kinematics::Nonlinear, 11, None, false, false);
+    let (mut gn, _) = model_at(sphere(), Kinematics::Nonlinear, 11, None, false, true);
+    let (ke, kg) = (dense(exact.matrix()), dense(gn.matrix()));
+    let scale = ke.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    // exact - Gauss-Newton = sum over the entering (here: all active) points of w lambda H, H = 2 I
+    // for |x - c|^2 - R^2, on the point's three displacement dofs
+    let mut expected = vec![vec![0.0; ke.len()]; ke.len()];
+    let pair = &gn.contacts[0];
+    let mut entering = 0;
+    for (p, s) in pair.points.iter().zip(&pair.state) {
+        if s.active {
+            entering += 1;
+            for &d in &p.dofs {
+                if let Some(e) = gn.dofs.equation(d) {
+                    expected[e][e] += p.weight * s.lambda * 2.0;
+                }
+            }
+        }
+    }
+    assert!(entering >= 3, "{entering} points in contact");
+    let worst = (0..ke.len()).flat_map(|i| (0..ke.len()).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max((ke[i][j] - kg[i][j] - expected[i][j]).abs()));
+    assert!(worst < 1e-12 * scale, "the tangents differ by more than the entering points' curvature terms: {worst:e}");
+    let largest = expected.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(largest > 1e-6 * scale, "the curvature terms are there to be missed: {largest:e}");
+    // evaluated again at the same state the points are no longer entering: the exact tangent
+    gn.evaluate(&u, 1.0, true).unwrap();
+    check_model(&mut gn, &u, false);
 }

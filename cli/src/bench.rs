@@ -155,6 +155,8 @@ fn build(n: usize) -> Result<Model<Plate>> {
     dofs.fix(mesh.group_nodes("right")?, &[2, 5])?; // simply supported: v3- = v3+ = 0
     dofs.fix(mesh.group_nodes("top")?, &[2, 5])?;
     let mut model = Model::new(Plate::TwoSurface(plate), dofs)?;
+    // the Newton iteration of `stamp run` (its default `[solver] newton = "mip"`)
+    model.mixed_tangent = true;
     let z = 0.5 * THICKNESS;
     let sphere = Arc::new(Sphere::new(Vector3::new(0.0, 0.0, z + RADIUS), RADIUS)?);
     let areas = mesh.nodal_areas();

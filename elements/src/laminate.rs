@@ -165,6 +165,8 @@ pub type FiveSurfaceLaminate = LaminatePlate<5, 20, 60>;
 pub struct LaminateWorkspace<const P: usize, const D: usize> {
     inner: MultiSurfaceWorkspace<P, D>,
     v: [f64; D],
+    /// A ply's dofs at the reference state of [`Element::evaluate_about`].
+    v_ref: [f64; D],
     residual: [f64; D],
     tangent: Vec<f64>,
     laws: [Law; 1],
@@ -296,23 +298,40 @@ impl<const N: usize, const P: usize, const D: usize> Element for LaminatePlate<N
         &self.cells[e]
     }
     fn new_workspace(&self) -> LaminateWorkspace<P, D> {
-        LaminateWorkspace { inner: workspace(N), v: [0.0; D], residual: [0.0; D], tangent: vec![0.0; D * D], laws: [Law::Isotropic { lambda: 0.0, mu: 0.0 }] }
+        LaminateWorkspace { inner: workspace(N), v: [0.0; D], v_ref: [0.0; D], residual: [0.0; D], tangent: vec![0.0; D * D], laws: [Law::Isotropic { lambda: 0.0, mu: 0.0 }] }
     }
 
     /// The sum over the plies; the nonlinear element refuses a state in which a ply turned inside
     /// out.
     fn evaluate(&self, e: usize, v: &[f64], ws: &mut LaminateWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_from(e, v, None, ws, out, with_tangent);
+    }
+
+    /// The geometric stiffness of every ply from the stresses of its strains linearised about
+    /// `reference`.
+    fn evaluate_about(&self, e: usize, v: &[f64], reference: &[f64], ws: &mut LaminateWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_from(e, v, Some(reference), ws, out, with_tangent);
+    }
+}
+
+impl<const N: usize, const P: usize, const D: usize> LaminatePlate<N, P, D> {
+    /// [`Element::evaluate`] and [`Element::evaluate_about`].
+    fn evaluate_from(&self, e: usize, v: &[f64], reference: Option<&[f64]>, ws: &mut LaminateWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
         let dt = 12 * self.surfaces;
         let mut ratio = f64::INFINITY;
         for (k, ply) in self.plies.iter().enumerate() {
             Self::gather(ply, v, &mut ws.v);
+            if let Some(r) = reference {
+                Self::gather(ply, r, &mut ws.v_ref);
+            }
             ws.laws[0] = self.law(e, k);
             ws.residual = [0.0; D];
             if with_tangent {
                 ws.tangent.fill(0.0);
             }
-            let LaminateWorkspace { inner, v: vl, residual, tangent, laws } = ws;
-            evaluate_levels(&self.geometry[e], &ply.levels, laws, self.kinematics, vl, inner, residual, tangent, &mut out.energy, with_tangent);
+            let LaminateWorkspace { inner, v: vl, v_ref, residual, tangent, laws } = ws;
+            let reference = reference.map(|_| &v_ref[..]);
+            evaluate_levels(&self.geometry[e], &ply.levels, laws, self.kinematics, vl, reference, inner, residual, tangent, &mut out.energy, with_tangent);
             ratio = ratio.min(inner.volume_ratio);
             for (i, &di) in ply.dofs.iter().enumerate() {
                 out.residual[di] += residual[i];

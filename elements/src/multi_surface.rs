@@ -225,6 +225,9 @@ pub struct MultiSurfaceWorkspace<const P: usize, const D: usize> {
     cb: Vec<[f64; D]>,
     /// Weights of the sample gradients in the residual and of their Hessians in the tangent.
     mu: Vec<f64>,
+    /// The samples' values linearised about a reference state (only `val` is used; see
+    /// [`Element::evaluate_about`]).
+    linear: Vec<Sample<P, D>>,
     pub(crate) volume_ratio: f64,
 }
 
@@ -470,6 +473,7 @@ pub(crate) fn workspace<const P: usize, const D: usize>(levels: usize) -> MultiS
         b: vec![[0.0; D]; levels * 4 * NVOIGT],
         cb: vec![[0.0; D]; levels * 4 * NVOIGT],
         mu: vec![0.0; levels * PER_LEVEL],
+        linear: vec![Sample::default(); levels * PER_LEVEL],
         volume_ratio: 1.0,
     }
 }
@@ -484,6 +488,7 @@ pub(crate) fn evaluate_levels<const N: usize, const P: usize, const D: usize>(
     laws: &[Law],
     kinematics: Kinematics,
     v: &[f64],
+    reference: Option<&[f64]>,
     ws: &mut MultiSurfaceWorkspace<P, D>,
     residual_out: &mut [f64],
     tangent_out: &mut [f64],
@@ -491,7 +496,7 @@ pub(crate) fn evaluate_levels<const N: usize, const P: usize, const D: usize>(
     with_tangent: bool,
 ) {
     compute_samples(geo, levels, kinematics, v, ws);
-    let MultiSurfaceWorkspace { samples, b, cb, mu, .. } = ws;
+    let MultiSurfaceWorkspace { samples, b, cb, mu, linear, .. } = ws;
     mu.fill(0.0);
     for (q, lv) in levels.iter().enumerate() {
         let law = &laws[lv.law];
@@ -540,6 +545,9 @@ pub(crate) fn evaluate_levels<const N: usize, const P: usize, const D: usize>(
     clean_upper_vector_state();
     // geometric stiffness: sum_s mu_s scale_s (a b^T + b a^T) (x) I3
     if kinematics == Kinematics::Nonlinear {
+        if let Some(reference) = reference {
+            linearised_weights(geo, levels, laws, v, reference, samples, mu, linear);
+        }
         let mut x = [[0.0; P]; P];
         for (k, smp) in samples.iter().enumerate() {
             let f = mu[k] * smp.scale;
@@ -556,6 +564,43 @@ pub(crate) fn evaluate_levels<const N: usize, const P: usize, const D: usize>(
             }
         }
         add_geometric_stiffness(&x, tangent_out);
+    }
+}
+
+/// The weights mu of the geometric stiffness with the stresses of the strains linearised about
+/// `reference` (see [`Element::evaluate_about`]): every sample's value less its quadratic
+/// remainder in v - reference ([`Sample::remainder`]), through the levels' laws.
+#[allow(clippy::too_many_arguments)]
+fn linearised_weights<const N: usize, const P: usize, const D: usize>(
+    geo: &ElementGeometry,
+    levels: &[Level<N>],
+    laws: &[Law],
+    v: &[f64],
+    reference: &[f64],
+    samples: &[Sample<P, D>],
+    mu: &mut [f64],
+    linear: &mut [Sample<P, D>],
+) {
+    let mut dv = [0.0; D];
+    for (k, x) in dv.iter_mut().enumerate() {
+        *x = v[k] - reference[k];
+    }
+    for (l, s) in linear.iter_mut().zip(samples) {
+        l.val = s.val - s.remainder(&dv);
+    }
+    mu.fill(0.0);
+    for (q, lv) in levels.iter().enumerate() {
+        let law = &laws[lv.law];
+        for g in 0..4 {
+            let w = geo.wdet[g] * lv.weight;
+            let s = law.stress(&strain(geo, linear, q, g));
+            for c in 0..NVOIGT {
+                let (t, n) = terms(geo, g, c);
+                for &(smp, coef) in &t[..n] {
+                    mu[q * PER_LEVEL + smp] += w * s[c] * coef;
+                }
+            }
+        }
     }
 }
 
@@ -586,8 +631,20 @@ impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePla
     /// The nonlinear element refuses a state in which it turned inside out (it still computes the
     /// residual and tangent there); the linear theory has no such limit.
     fn evaluate(&self, e: usize, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_from(e, v, None, ws, out, with_tangent);
+    }
+
+    /// The geometric stiffness from the stresses of the strains linearised about `reference`.
+    fn evaluate_about(&self, e: usize, v: &[f64], reference: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_from(e, v, Some(reference), ws, out, with_tangent);
+    }
+}
+
+impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> {
+    /// [`Element::evaluate`] and [`Element::evaluate_about`].
+    fn evaluate_from(&self, e: usize, v: &[f64], reference: Option<&[f64]>, ws: &mut MultiSurfaceWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
         let LocalSystem { residual, tangent, energy, .. } = out;
-        evaluate_levels(&self.geometry[e], &self.levels, &self.laws, self.kinematics, v, ws, residual, tangent, energy, with_tangent);
+        evaluate_levels(&self.geometry[e], &self.levels, &self.laws, self.kinematics, v, reference, ws, residual, tangent, energy, with_tangent);
         if self.kinematics == Kinematics::Nonlinear && ws.volume_ratio <= 0.0 {
             out.inadmissible = Some(inside_out(ws.volume_ratio));
         }

@@ -322,9 +322,22 @@ impl Element for PlateElements {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2.
-            return unsafe { self.evaluate_avx2(e, v, ws, out, with_tangent) };
+            return unsafe { self.evaluate_avx2(e, v, None, ws, out, with_tangent) };
         }
-        self.evaluate_kernel(e, v, ws, out, with_tangent)
+        self.evaluate_kernel(e, v, None, ws, out, with_tangent)
+    }
+
+    /// The geometric stiffness from the resultants of the strains linearised about `reference`
+    /// (see [`Element::evaluate_about`]): a Green-Lagrange sample is exactly quadratic, so its
+    /// linearisation about the reference is its value at `v` less s (C_a dv) . (C_b dv),
+    /// dv = v - reference.
+    fn evaluate_about(&self, e: usize, v: &[f64], reference: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { self.evaluate_avx2(e, v, Some(reference), ws, out, with_tangent) };
+        }
+        self.evaluate_kernel(e, v, Some(reference), ws, out, with_tangent)
     }
 }
 
@@ -332,13 +345,13 @@ impl PlateElements {
     /// [`Element::evaluate`] compiled for AVX2 (no FMA: the same operations, the same results).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn evaluate_avx2(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
-        self.evaluate_kernel(e, v, ws, out, with_tangent)
+    unsafe fn evaluate_avx2(&self, e: usize, v: &[f64], reference: Option<&[f64]>, ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+        self.evaluate_kernel(e, v, reference, ws, out, with_tangent)
     }
 
     /// The body of [`Element::evaluate`], inlined into the baseline and the AVX2 builds.
     #[inline(always)]
-    fn evaluate_kernel(&self, e: usize, v: &[f64], ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
+    fn evaluate_kernel(&self, e: usize, v: &[f64], reference: Option<&[f64]>, ws: &mut PlateWorkspace, out: &mut LocalSystem, with_tangent: bool) {
         self.compute_samples(e, v, ws);
         if self.kinematics == Kinematics::Nonlinear && ws.volume_ratio <= 0.0 {
             out.inadmissible = Some(format!(
@@ -450,6 +463,9 @@ impl PlateElements {
         }
         // geometric stiffness: sum_s mu_s Hess_s (x) I3, Hess_s = scale (a b^T + b a^T)
         if self.kinematics == Kinematics::Nonlinear {
+            if let Some(reference) = reference {
+                linearised_weights(geo, &self.d, samples, terms, v, reference, mu);
+            }
             // X = sum_s mu_s scale_s a_s b_s^T, and H = X + X^T; a_s and b_s of a membrane sample
             // have nonzeros only at the pairs of its face, a_s of a shear sample likewise
             let mut x = [[0.0; NPAIR]; NPAIR];
@@ -483,6 +499,40 @@ impl PlateElements {
     }
 }
 
+/// The weights mu_s = sum_c w T_c coef_cs of the geometric stiffness with the resultants T = D E
+/// of the assumed strains linearised about `reference` (see [`Element::evaluate_about`]): each
+/// sample's value less its quadratic remainder s (C_a dv) . (C_b dv), dv = v - reference.
+#[inline(always)]
+fn linearised_weights(geo: &ElementGeometry, d: &[[f64; NSTRAIN]; NSTRAIN], samples: &[Sample; NSAMPLE], terms: &[[Terms; NSTRAIN]; 4], v: &[f64], reference: &[f64], mu: &mut [f64; NSAMPLE]) {
+    let mut dv = [0.0; NDOF];
+    for (k, x) in dv.iter_mut().enumerate() {
+        *x = v[k] - reference[k];
+    }
+    let mut linear = [0.0; NSAMPLE];
+    let shear = if geo.parallelogram { LINE } else { TYING };
+    for s in (MEM..E33 + 4).chain(shear..shear + 8) {
+        linear[s] = samples[s].val - samples[s].remainder(&dv);
+    }
+    *mu = [0.0; NSAMPLE];
+    for g in 0..4 {
+        let w = geo.wdet[g];
+        let mut strain = [0.0; NSTRAIN];
+        for c in 0..NSTRAIN {
+            let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
+            let (t, n) = &terms[first][c];
+            strain[c] = t[..*n].iter().fold(0.0, |sum, &(s, coef)| sum + coef * linear[s]);
+        }
+        for c in 0..NSTRAIN {
+            let stress: f64 = (0..NSTRAIN).map(|k| d[c][k] * strain[k]).sum();
+            let first = if c < 6 { MEMBRANE_GROUP_FIRST[c / 2][g] } else { g };
+            let (t, n) = &terms[first][c];
+            for &(s, coef) in &t[..*n] {
+                mu[s] += w * stress * coef;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -510,8 +560,20 @@ mod tests {
     /// r = sum_g B_g^T w D E_g, K = sum_g B_g^T w D B_g + sum_s mu_s Hess_s (x) I3, and P the same
     /// with D0 = D without `D[E33][in-plane]`; the fast kernel must agree to round-off.
     fn reference(plate: &PlateElements, v: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>, f64) {
+        reference_about(plate, v, None)
+    }
+
+    /// The same with the geometric stiffness's resultants from the strains linearised about
+    /// `about` (Element::evaluate_about): E(about) + dE/dv(about) (v - about), from the samples'
+    /// values and gradients at `about`.
+    fn reference_about(plate: &PlateElements, v: &[f64], about: Option<&[f64]>) -> (Vec<f64>, Vec<f64>, Vec<f64>, f64) {
         let mut ws = plate.new_workspace();
         plate.compute_samples(0, v, &mut ws);
+        let linear: Option<Vec<f64>> = about.map(|a| {
+            let mut wa = plate.new_workspace();
+            plate.compute_samples(0, a, &mut wa);
+            wa.samples.iter().map(|s| s.val + (0..NDOF).map(|i| s.grad[i] * (v[i] - a[i])).sum::<f64>()).collect()
+        });
         let (geo, d, smp) = (&plate.geometry[0], &plate.d, &ws.samples);
         let (mut r, mut k, mut p, mut energy) = (vec![0.0; NDOF], vec![0.0; NDOF * NDOF], vec![0.0; NDOF * NDOF], 0.0);
         let mut mu = [0.0; NSAMPLE];
@@ -530,12 +592,20 @@ mod tests {
             }
             let stress: Vec<f64> = (0..NSTRAIN).map(|rr| (0..NSTRAIN).map(|c| d[rr][c] * strain[c]).sum()).collect();
             energy += 0.5 * w * (0..NSTRAIN).map(|c| strain[c] * stress[c]).sum::<f64>();
+            // the resultants of the geometric stiffness
+            let geometric: Vec<f64> = match &linear {
+                None => stress.clone(),
+                Some(lin) => {
+                    let e: Vec<f64> = (0..NSTRAIN).map(|c| terms[c].0[..terms[c].1].iter().map(|&(s, coef)| coef * lin[s]).sum()).collect();
+                    (0..NSTRAIN).map(|rr| (0..NSTRAIN).map(|c| d[rr][c] * e[c]).sum()).collect()
+                }
+            };
             for c in 0..NSTRAIN {
                 for i in 0..NDOF {
                     r[i] += w * stress[c] * b[c][i];
                 }
                 for &(s, coef) in &terms[c].0[..terms[c].1] {
-                    mu[s] += w * stress[c] * coef;
+                    mu[s] += w * geometric[c] * coef;
                 }
                 for rr in 0..NSTRAIN {
                     for i in 0..NDOF {
@@ -594,8 +664,23 @@ mod tests {
                 plate.evaluate(0, &v, &mut ws, &mut residual, false);
                 // the kernel compiled for baseline x86-64 (what `evaluate` runs without AVX2)
                 let mut baseline = LocalSystem::with_preconditioner(NDOF);
-                plate.evaluate_kernel(0, &v, &mut ws, &mut baseline, true);
+                plate.evaluate_kernel(0, &v, None, &mut ws, &mut baseline, true);
+                // linearised about another state: the residual is the same, the tangent that of
+                // the plain computation with the linearised resultants
+                let about: Vec<f64> = v.iter().enumerate().map(|(k, x)| x - 0.3 * ((k * 104729 % 1000) as f64 / 500.0 - 1.0)).collect();
+                let (_, k_about, p_about, _) = reference_about(&plate, &v, Some(&about));
+                let mut mixed = LocalSystem::with_preconditioner(NDOF);
+                plate.evaluate_about(0, &v, &about, &mut ws, &mut mixed, true);
+                let mut same = LocalSystem::with_preconditioner(NDOF);
+                plate.evaluate_about(0, &v, &v, &mut ws, &mut same, true);
+                if kin == Kinematics::Nonlinear {
+                    assert!(rel(&k_about, &k) > 1e-3, "the linearised resultants change the tangent");
+                }
                 for (what, err) in [
+                    ("residual about", rel(&mixed.residual, &r)),
+                    ("tangent about", rel(&mixed.tangent, &k_about)),
+                    ("P about", rel(&mixed.preconditioner, &p_about)),
+                    ("tangent about itself", rel(&same.tangent, &k)),
                     ("residual", rel(&out.residual, &r)),
                     ("residual alone", rel(&residual.residual, &r)),
                     ("tangent", rel(&out.tangent, &k)),

@@ -92,6 +92,26 @@ impl<const P: usize, const D: usize> Sample<P, D> {
         }
     }
 
+    /// The part of the strain's change under the increment `dv` of the element dofs that is
+    /// quadratic in it: s (C_a dv) . (C_b dv), with C_a dv = sum_k a_k dv_k over the (node,
+    /// surface) pairs. A Green-Lagrange strain is exactly quadratic, so its value at v less this
+    /// remainder of dv = v - v0 is its linearisation about v0, E(v0) + dE/dv(v0) dv (zero for a
+    /// linear strain, whose scale is 0).
+    #[inline(always)]
+    pub fn remainder(&self, dv: &[f64]) -> f64 {
+        if self.scale == 0.0 {
+            return 0.0;
+        }
+        let (mut da, mut db) = ([0.0; 3], [0.0; 3]);
+        for k in 0..P {
+            for i in 0..3 {
+                da[i] += self.a[k] * dv[3 * k + i];
+                db[i] += self.b[k] * dv[3 * k + i];
+            }
+        }
+        self.scale * dot(&da, &db)
+    }
+
     /// Hessian coefficient (k, l) over the (node, surface) pairs.
     pub fn hessian(&self, k: usize, l: usize) -> f64 {
         self.scale * (self.a[k] * self.b[l] + self.b[k] * self.a[l])

@@ -513,6 +513,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         punches.push(PunchInfo { name, face, z, surface, eps_reg, eps_automatic });
     }
     model.augmented_tolerance = tolerance;
+    model.mixed_tangent = s.solver.newton.unwrap_or_default() == super::problem::NewtonTangent::Mip;
 
     // solver
     let sv = &s.solver;

@@ -286,6 +286,18 @@ impl Element for Plate {
             _ => unreachable!("a workspace is made by its own plate"),
         }
     }
+    fn evaluate_about(&self, e: usize, u: &[f64], reference: &[f64], ws: &mut PlateWs, out: &mut LocalSystem, with_tangent: bool) {
+        match (self, ws) {
+            (Plate::TwoSurface(p), PlateWs::TwoSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
+            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
+            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
+            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
+            (Plate::ThreeSurfaceLayers(p), PlateWs::ThreeSurfaceLayers(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
+            (Plate::FourSurfaceLayers(p), PlateWs::FourSurfaceLayers(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
+            (Plate::FiveSurfaceLayers(p), PlateWs::FiveSurfaceLayers(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
+            _ => unreachable!("a workspace is made by its own plate"),
+        }
+    }
 }
 
 #[cfg(test)]

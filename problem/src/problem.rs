@@ -875,10 +875,26 @@ pub struct SolverSpec {
     /// Where each load step starts (default "secant").
     #[serde(default)]
     pub predictor: Option<Spanned<Predictor>>,
+    /// Newton's tangent (default "mip").
+    #[serde(default)]
+    pub newton: Option<NewtonTangent>,
     /// PETSc options for the linear solve ("-ksp_type cg -pc_type gamg"), for a stamp built with
     /// the feature `petsc` (see crate::parallel).
     #[serde(default)]
     pub petsc_options: Option<Spanned<String>>,
+}
+
+/// `[solver] newton`: the stresses of Newton's geometric stiffness.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum NewtonTangent {
+    /// The stresses of the strains linearised about the last iterate (the mixed-integration-point
+    /// iteration, stamp::element::Element::evaluate_about): the same answers in fewer iterations
+    /// on thin plates under large rotations.
+    #[default]
+    Mip,
+    /// The stresses at the iterate: the exact derivative of the residual (the paper's Newton).
+    Standard,
 }
 
 /// `[solver] predictor`: the start of each load step.

@@ -219,3 +219,34 @@ fn barely_tensile_points_leave_after_the_most_tensile_one() {
     evaluate(&mut q, [1e-3; 4]);
     assert_eq!(evaluate(&mut q, lifted), (3, vec![false, false, false, true]));
 }
+
+#[test]
+fn a_tension_that_falls_tenfold_at_each_iteration_is_held_and_one_that_does_not_is_released() {
+    // all four points in contact; then the first lifts off (trial 10) and the third is barely
+    // tensile (0.2): held by the release fraction. Its tension then falls to 0.01 and 0.0001
+    // (the remainder of a convex punch's linearisation converging away): still held, each time
+    // a change; back in compression it stays in with no change
+    let mut p = pair(0.5);
+    assert_eq!(p.hold_converging, true);
+    evaluate(&mut p, [1e-3; 4]);
+    assert_eq!(evaluate(&mut p, [1e-3; 4]), (0, vec![true; 4]));
+    let lift = |w2: f64| [-1.0 + 1e-3, 1e-3, 1e-3 - w2, 1e-3];
+    assert_eq!(evaluate(&mut p, lift(0.02)), (2, vec![false, true, true, true]));
+    assert_eq!(evaluate(&mut p, lift(0.001)), (1, vec![false, true, true, true]), "0.01 < 0.1 x 0.2: held");
+    assert!((p.state[2].lambda - 0.01).abs() < 1e-12, "with its exact trial multiplier");
+    assert_eq!(evaluate(&mut p, lift(1e-5)), (1, vec![false, true, true, true]), "1e-4 < 0.1 x 0.01: held");
+    assert_eq!(evaluate(&mut p, lift(-1e-5)), (0, vec![false, true, true, true]), "pressed again");
+    // a tension that does not fall tenfold (0.2, then 0.15) is a lift-off: released
+    let mut q = pair(0.5);
+    evaluate(&mut q, [1e-3; 4]);
+    evaluate(&mut q, [1e-3; 4]);
+    assert_eq!(evaluate(&mut q, lift(0.02)), (2, vec![false, true, true, true]));
+    assert_eq!(evaluate(&mut q, lift(0.015)), (1, vec![false, true, false, true]));
+    // hold_converging = false: released as soon as it is the most tensile
+    let mut r = pair(0.5);
+    r.hold_converging = false;
+    evaluate(&mut r, [1e-3; 4]);
+    evaluate(&mut r, [1e-3; 4]);
+    evaluate(&mut r, lift(0.02));
+    assert_eq!(evaluate(&mut r, lift(0.001)), (1, vec![false, true, false, true]));
+}
