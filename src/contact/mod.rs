@@ -303,17 +303,18 @@ pub const CONVERGING_TENSION: f64 = 0.1;
 
 /// An entering point (compressive, not active at the last evaluation with a tangent) gets the
 /// Gauss-Newton tangent w eps G G^T, without the curvature term w lambda H, at the body's first
-/// contact with the punch and, at the first iteration of a load step, where its Psi is deep
-/// relative to the punch's curvature: |Psi| |H| > DEEP_ENTRY_RATIO |grad Psi|^2 (for a sphere
-/// or cylinder written as |x - c|^2 - R^2 about 4 times the penetration over the radius). Its
+/// contact with the punch and wherever its Psi is deep relative to the punch's curvature:
+/// |Psi| |H| > DEEP_ENTRY_RATIO |grad Psi|^2 (for a sphere or cylinder written as
+/// |x - c|^2 - R^2 about 4 times the penetration over the radius). Its
 /// multiplier eps Psi then measures how far the iterate overran the punch, not a contact pressure,
 /// and the curvature term built from it, negative in every direction, makes the tangent
 /// indefinite: the Newton step throws the point sideways and far beyond the punch's surface.
 /// Measured on every shipped example, the README tutorial, a torus die and the cylinder across
 /// gmsh triangles (docs/performance.md): cylinder-30deg 33 -> 26 Newton iterations, the paper's
-/// R = 100 strip 108 -> 97; dropping it for every entering point instead cost the sphere problems
-/// up to 5 iterations (their step-start penetrations are shallow, and the term is the sliding
-/// stiffness of a pressed point on a curved punch).
+/// R = 100 strip 108 -> 99, the torus die on triangles of size 1 without its two cut-backs;
+/// dropping it for every entering point instead cost the sphere problems up to 5 iterations
+/// (their entries are shallow, and the term is the sliding stiffness of a pressed point on a
+/// curved punch).
 pub const DEEP_ENTRY_RATIO: f64 = 1e-3;
 
 /// The default [`ContactPair::entry_fraction`].
@@ -711,13 +712,13 @@ impl ContactPair {
                 force[f.dof] += w * lambda * grad_s;
             }
             if let Some(add) = add_tangent.as_deref_mut() {
-                // an entering point deep inside the punch: the Gauss-Newton tangent (see
-                // DEEP_ENTRY_RATIO)
+                // an entering point deep inside the punch, or at the first contact: the
+                // Gauss-Newton tangent (see DEEP_ENTRY_RATIO)
                 let deep = self.gauss_newton_entry
                     && active
                     && !was_active
                     && lambda < 0.0
-                    && hess.as_ref().is_some_and(|x| self.converged_scale == 0.0 || (self.step_start && psi.abs() * self.surface.hessian(x).norm() > DEEP_ENTRY_RATIO * grad.norm_squared()));
+                    && hess.as_ref().is_some_and(|x| self.converged_scale == 0.0 || (psi.abs() * self.surface.hessian(x).norm() > DEEP_ENTRY_RATIO * grad.norm_squared()));
                 let curvature = if deep { 0.0 } else { lambda };
                 point_tangent(&*self.surface, p, drive.as_ref(), &dn, &grad, grad_s, hess.as_ref(), w * self.eps_reg, w * curvature, add);
             }
