@@ -203,6 +203,10 @@ pub struct ContactPair {
     /// The points that entered the active set at the last evaluation with a tangent: the next
     /// such evaluation does not release them (see [`ContactPair::evaluate`]).
     entered: Vec<bool>,
+    /// The points that entered with the Gauss-Newton tangent at that evaluation (see
+    /// [`DEEP_ENTRY_RATIO`]): held at the next one also in a step started from an outside
+    /// prediction, whose other entries are not held.
+    entered_deep: Vec<bool>,
     /// Hold a point that entered for one iteration (default true; false: the plain semi-smooth
     /// rule, which releases it at once).
     pub hold_after_entry: bool,
@@ -381,6 +385,7 @@ impl ContactPair {
             needs_coupling: false,
             coupling_reach: 0.0,
             entered: vec![false; n],
+            entered_deep: vec![false; n],
             hold_after_entry: true,
             release_fraction: RELEASE_FRACTION,
             hold_converging: true,
@@ -461,6 +466,7 @@ impl ContactPair {
     pub fn start_step(&mut self, predicted: bool) {
         self.predicted_step = predicted;
         self.entered.fill(false);
+        self.entered_deep.fill(false);
         self.flips.fill(0);
         self.frozen.fill(false);
         self.step_start = true;
@@ -648,7 +654,7 @@ impl ContactPair {
             let active = if deferred {
                 changes += 1;
                 false
-            } else if with_tangent && (self.hold_after_update || (self.entered[k] && self.hold_after_entry && !self.hold_active_set && !self.predicted_step) || trial < release_cut || converging) && self.last_active[k] && !wanted && !self.frozen[k] {
+            } else if with_tangent && (self.hold_after_update || (self.entered[k] && self.hold_after_entry && !self.hold_active_set && (!self.predicted_step || self.entered_deep[k])) || trial < release_cut || converging) && self.last_active[k] && !wanted && !self.frozen[k] {
                 // right after an augmented-Lagrangian update (hold_after_update), or right after
                 // the point entered: not released yet. A Newton step puts a point that enters onto
                 // the punch's tangent plane at its last position; on a convex punch Psi is positive
@@ -687,11 +693,19 @@ impl ContactPair {
                 }
                 wanted
             };
+            let lambda = if active { trial } else { 0.0 };
+            // an entering point deep inside the punch, or at the first contact: the Gauss-Newton
+            // tangent (see DEEP_ENTRY_RATIO)
+            let deep = self.gauss_newton_entry
+                && active
+                && !was_active
+                && lambda < 0.0
+                && hess.as_ref().is_some_and(|x| self.converged_scale == 0.0 || psi.abs() * self.surface.hessian(x).norm() > DEEP_ENTRY_RATIO * grad.norm_squared());
             if with_tangent {
                 self.entered[k] = active && !was_active;
+                self.entered_deep[k] = deep;
                 self.last_trial[k] = trial;
             }
-            let lambda = if active { trial } else { 0.0 };
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
             // a point that cycled keeps the active-side tangent near the kink (its force stays exact)
             let near_kink = !self.hold_active_set && self.frozen[k] && with_tangent && trial <= band;
@@ -712,13 +726,6 @@ impl ContactPair {
                 force[f.dof] += w * lambda * grad_s;
             }
             if let Some(add) = add_tangent.as_deref_mut() {
-                // an entering point deep inside the punch, or at the first contact: the
-                // Gauss-Newton tangent (see DEEP_ENTRY_RATIO)
-                let deep = self.gauss_newton_entry
-                    && active
-                    && !was_active
-                    && lambda < 0.0
-                    && hess.as_ref().is_some_and(|x| self.converged_scale == 0.0 || (psi.abs() * self.surface.hessian(x).norm() > DEEP_ENTRY_RATIO * grad.norm_squared()));
                 let curvature = if deep { 0.0 } else { lambda };
                 point_tangent(&*self.surface, p, drive.as_ref(), &dn, &grad, grad_s, hess.as_ref(), w * self.eps_reg, w * curvature, add);
             }
