@@ -424,7 +424,7 @@ pub fn after_the_run(p: &Problem, summary: &Path) -> Vec<String> {
         if let Some(last) = converged.last() {
             if last["punches"][&name]["zone_narrower_than_cells"] == serde_json::Value::Bool(true) {
                 out.push(format!(
-                    "{}: punch[{i}] ('{}') touches the plate on a zone narrower than the cells (a line or ring of nodes, none with all its neighbours in contact) at the last step: its peak pressure depends on the mesh and will not converge as the cells shrink; the force does, and so does the load per unit length that a probe across the zone reads (column {}_line_load)",
+                    "{}: punch[{i}] ('{}') touches the plate on a zone narrower than the cells (a line or ring of nodes, none with all its neighbours in contact) at the last step: its peak pressure depends on the mesh and will not converge as the cells shrink; the force does, and so does the load per unit length: across a straight line what a probe across it reads (column {}_line_load), around a ring the force over the ring's circumference",
                     file(p),
                     quote(&name),
                     name
