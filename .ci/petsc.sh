@@ -63,16 +63,39 @@ for f in meshes/*.toml; do
   done
 done
 
-# rank 0 alone cannot make its output folder: it ends every rank with its message
+# rank 0 cannot make its output folder: the failure is agreed at once, one message on every rank
 t0=$SECONDS
-if timeout 120 "${mpirun[@]}" -n 2 "$stamp" run meshes/sphere-ss.toml --out /proc/stamp-cannot-write -q 2>"$work/alone.err"; then
+if timeout 120 "${mpirun[@]}" -n 2 "$stamp" run meshes/sphere-ss.toml --out /proc/stamp-cannot-write -q 2>"$work/folder.err"; then
+  bad "an output folder rank 0 cannot make: the job succeeded"
+elif [ $? = 124 ]; then
+  bad "an output folder rank 0 cannot make: the job hung"
+elif [ "$(grep -c '^error: ' "$work/folder.err")" = 1 ] && grep -q "^error: /proc/stamp-cannot-write" "$work/folder.err" && [ $((SECONDS - t0)) -lt 15 ]; then
+  ok
+else
+  bad "an output folder rank 0 cannot make ($((SECONDS - t0)) s): $(cat "$work/folder.err")"
+fi
+# rank 1 alone fails before the solve (its problem file is missing) while rank 0 waits for it in
+# a collective call: rank 1 ends the job with its message (MPI_Abort) after ALONE_AFTER seconds
+t0=$SECONDS
+if timeout 120 "${mpirun[@]}" -n 1 "$stamp" run meshes/sphere-ss.toml --out "$work/alone" -q : -n 1 "$stamp" run "$work/no-such.toml" -q 2>"$work/alone.err"; then
   bad "a rank that failed alone: the job succeeded"
 elif [ $? = 124 ]; then
   bad "a rank that failed alone: the job hung"
-elif grep -q "^error: rank 0 of 2: /proc/stamp-cannot-write" "$work/alone.err"; then
+elif grep -q "^error: rank 1 of 2: .*no-such.toml" "$work/alone.err"; then
   echo "a rank that failed alone ended the job in $((SECONDS - t0)) s"; ok
 else
   bad "a rank that failed alone: $(cat "$work/alone.err")"
+fi
+# the ranks other than 0 write no file: rank 1, given an output folder of its own, leaves it
+# unmade, and nothing in the job's TMPDIR; rank 0's folder is complete
+mkdir "$work/tmp"
+if timeout 300 "${mpirun[@]}" -x TMPDIR="$work/tmp" -n 1 "$stamp" run meshes/.ci-petsc-sphere-ss.toml --out "$work/writer" -q : -n 1 "$stamp" run meshes/.ci-petsc-sphere-ss.toml --out "$work/not-written" -q 2>"$work/writer.err" && \
+   ! [ -e "$work/not-written" ] && [ -z "$(ls -A "$work/tmp")" ] && \
+   python3 .ci/compare_history.py "$work/faer-sphere-ss/history.csv" "$work/writer/history.csv" 1e-8 && \
+   [ "$(ls "$work/writer"/*.vtu | wc -l)" = "$(ls "$work/faer-sphere-ss"/*.vtu | wc -l)" ]; then
+  ok
+else
+  bad "ranks other than 0 wrote files, or rank 0's outputs are incomplete: $(ls -A "$work/tmp" "$work/not-written" 2>&1 | head -5) $(cat "$work/writer.err")"
 fi
 # a Newton failure on 2 ranks: one message, summary.json failed
 sed -e 's/^\[solver\]/[solver]\nmax_iterations = 2\nmax_cutbacks = 1/' -e "s|file = \"|file = \"$PWD/meshes/|" meshes/sphere-ss.toml >"$work/newton.toml"

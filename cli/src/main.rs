@@ -104,14 +104,12 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    #[cfg(feature = "petsc")]
-    let out_dir = |out: Option<PathBuf>| ranks.out_dir(out.as_deref()).map(std::path::Path::to_path_buf);
-    #[cfg(not(feature = "petsc"))]
-    let out_dir = |out: Option<PathBuf>| out;
+    // under MPI only rank 0 writes files (the paper's figure too)
+    let writes = stamp_problem::parallel::writes_outputs();
     let result = match cli.command {
         None => stamp_cli::paper::paper_command(false, None),
-        Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref()),
-        Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::commands::run_command(&problem, out_dir(out).as_deref(), quiet, refine.map(usize::from)),
+        Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref().filter(|_| writes)),
+        Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::commands::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
         Some(Command::Check { problem }) => stamp_cli::commands::check_command(&problem),
         Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, predictor, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor }),
         Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, predictor, one: None }) => {

@@ -5,9 +5,10 @@
 //! - With P > 1 each rank runs its rayon work on one thread: the ranks are the parallelism, and
 //!   the replicated computation (stamp_problem::parallel) must give every rank the same numbers to
 //!   the bit, which a reduction over a varying number of threads would not.
-//! - Rank 0 writes the outputs and prints; the other ranks run the same code into a scratch folder
-//!   of their own (removed at the end) with stdout and stderr on /dev/null, so that every rank
-//!   makes the same collective calls in the same order.
+//! - Rank 0 writes the outputs and prints; the other ranks write no file at all
+//!   (stamp_problem::parallel::writes_outputs) and have stdout and stderr on /dev/null, but run
+//!   the same code otherwise, so that every rank makes the same collective calls in the same
+//!   order.
 //! - The outcome is agreed at the end: every rank exits with the error of the lowest rank that
 //!   failed, printed once by rank 0. A rank that failed and finds the others still busy after
 //!   [`ALONE_AFTER`] seconds (it failed alone, before the solve: its output folder could not be
@@ -17,7 +18,6 @@
 //!   step: stamp_problem::parallel::any_rank), so they end here together.
 
 use stamp_petsc::Petsc;
-use std::path::{Path, PathBuf};
 
 /// Seconds a rank that failed waits for the others at the end before it ends the job.
 pub const ALONE_AFTER: f64 = 20.0;
@@ -25,7 +25,6 @@ pub const ALONE_AFTER: f64 = 20.0;
 /// PETSc for the life of the command.
 pub struct Ranks {
     petsc: Petsc,
-    scratch: Option<PathBuf>,
     /// The original stderr (rank > 0 prints nothing else).
     stderr: i32,
 }
@@ -35,7 +34,6 @@ impl Ranks {
     pub fn start() -> Result<Ranks, String> {
         let petsc = Petsc::initialize().map_err(|e| format!("cannot start PETSc and MPI: {e}"))?;
         let (rank, size) = (petsc.rank(), petsc.size());
-        let mut scratch = None;
         let mut stderr = 2;
         if size > 1 {
             let _ = rayon::ThreadPoolBuilder::new().num_threads(1).build_global();
@@ -49,7 +47,6 @@ impl Ranks {
                     libc::dup2(null.as_raw_fd(), 1);
                     libc::dup2(null.as_raw_fd(), 2);
                 }
-                scratch = Some(std::env::temp_dir().join(format!("stamp-rank{rank}-{}", std::process::id())));
             }
             std::panic::set_hook(Box::new(move |info| {
                 let text = format!("error: rank {rank} of {size} panicked: {info}\n");
@@ -57,15 +54,10 @@ impl Ranks {
                 stamp_petsc::petsc::abort_world(101);
             }));
         }
-        Ok(Ranks { petsc, scratch, stderr })
+        Ok(Ranks { petsc, stderr })
     }
 
-    /// The output folder of this rank: `out` on rank 0, a scratch folder of its own elsewhere.
-    pub fn out_dir<'a>(&'a self, out: Option<&'a Path>) -> Option<&'a Path> {
-        self.scratch.as_deref().or(out)
-    }
-
-    /// The command's outcome, the same on every rank (collective); the scratch folder removed.
+    /// The command's outcome, the same on every rank (collective).
     /// [`end`](Self::end) follows once rank 0 has printed it.
     pub fn finish(&mut self, result: Result<(), String>) -> Result<(), String> {
         let (rank, size) = (self.petsc.rank(), self.petsc.size());
@@ -76,9 +68,6 @@ impl Ranks {
                 (_, Err(e)) => {
                     let text = format!("error: rank {rank} of {size}: {e}\n(the other ranks did not stop within {ALONE_AFTER} s: ending them)\n");
                     unsafe { libc::write(self.stderr, text.as_ptr().cast(), text.len()) };
-                    if let Some(dir) = &self.scratch {
-                        let _ = std::fs::remove_dir_all(dir);
-                    }
                     self.petsc.abort(1)
                 }
                 (Err(e), Ok(())) => Err(e.to_string()),
@@ -87,9 +76,6 @@ impl Ranks {
         } else {
             result
         };
-        if let Some(dir) = &self.scratch {
-            let _ = std::fs::remove_dir_all(dir);
-        }
         agreed
     }
 

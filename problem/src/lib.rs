@@ -82,8 +82,10 @@ pub fn solve_problem(p: &Problem, out_dir: &Path, options: &solve::SolveOptions)
         eprintln!("warning: {w}");
     }
     let outcome = solve::solve_and_write(p, setup, out_dir, options);
-    for w in check::after_the_run(p, &out_dir.join("summary.json")) {
-        eprintln!("warning: {w}");
+    if parallel::writes_outputs() {
+        for w in check::after_the_run(p, &out_dir.join("summary.json")) {
+            eprintln!("warning: {w}");
+        }
     }
     outcome
 }

@@ -22,9 +22,9 @@
 //! same everywhere by construction), and every rank runs the same Newton iterations on the
 //! gathered solution; so the active sets, the augmented-Lagrangian updates, the line search and
 //! every convergence test are the same on every rank (PetscSolver checks that the right-hand sides
-//! agree to the bit). The outputs are computed on every rank, written by rank 0. A failure in the
-//! solve is agreed over the ranks; one in writing (rank 0 only) stops every rank after the step
-//! ([`any_rank`]).
+//! agree to the bit). The outputs are computed and written by rank 0 only ([`writes_outputs`]).
+//! A failure in the solve is agreed over the ranks; one in writing (rank 0 only) is agreed where
+//! it happens ([`on_writer`]) or stops every rank after the step ([`any_rank`]).
 
 use crate::problem::Problem;
 use stamp::Result;
@@ -67,6 +67,37 @@ pub fn any_rank(flag: bool) -> bool {
         }
     }
     flag
+}
+
+/// Whether this process writes the run's output files and prints its table: rank 0 (the one
+/// process without MPI). The other ranks write nothing at all; they take part in every collective
+/// call and skip the rest.
+pub fn writes_outputs() -> bool {
+    rank() == 0
+}
+
+/// The same outcome on every rank (collective under MPI; `local` itself otherwise): Ok where
+/// every rank is Ok (each keeps its own value), else an error on every rank -- a failing rank
+/// keeps its own, the others get the lowest failing rank's message. For a step that can fail on
+/// some ranks only (the writes of rank 0), so that the ranks stop together.
+pub fn agree<T>(local: Result<T>) -> Result<T> {
+    #[cfg(feature = "petsc")]
+    if let Some(p) = stamp_petsc::Petsc::current() {
+        if p.size() > 1 {
+            return match p.agree(local.as_ref().map(|_| ()).map_err(|e| e.to_string())) {
+                Ok(()) => local,
+                Err(message) => Err(local.err().unwrap_or(stamp::StampError::Problem(message))),
+            };
+        }
+    }
+    local
+}
+
+/// `write` run by the process that writes the outputs ([`writes_outputs`]), its outcome agreed
+/// over the ranks ([`agree`], collective): Some(its value) there, None on the other ranks, or its
+/// error on every rank.
+pub fn on_writer<T>(write: impl FnOnce() -> Result<T>) -> Result<Option<T>> {
+    agree(if writes_outputs() { write().map(Some) } else { Ok(None) })
 }
 
 /// On P > 1 ranks, share the model over them (see `stamp::share`): METIS splits the elements

@@ -69,8 +69,13 @@ pub fn check_levels_fit(sizes: &[(u64, u64)], levels: usize, dofs_per_node: u64,
     Ok(())
 }
 
-/// Rewrite summary.json in `dir` with `edit` applied (atomically).
+/// Rewrite summary.json in `dir` with `edit` applied (atomically), on the process that writes the
+/// outputs (collective under MPI: the outcome is agreed, see [`super::parallel::on_writer`]).
 fn edit_summary(dir: &Path, edit: impl FnOnce(&mut Value)) -> Result<()> {
+    super::parallel::on_writer(|| edit_summary_here(dir, edit)).map(|_| ())
+}
+
+fn edit_summary_here(dir: &Path, edit: impl FnOnce(&mut Value)) -> Result<()> {
     let path = dir.join("summary.json");
     let text = super::regular::read_regular(&path)?.ok_or_else(|| StampError::io(&path, std::io::ErrorKind::NotFound.into()))?;
     let mut v: Value = serde_json::from_str(&text).map_err(|e| StampError::Problem(format!("{}: cannot read back summary.json: {e}", stamp::show_path(&path))))?;
@@ -103,8 +108,10 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     check_levels_fit(&sizes, levels, p.spec.plate.get_ref().dofs_per_node(), super::memory::available_bytes()).map_err(|m| p.error_at(p.spec.mesh.span(), "mesh", m))?;
     let out_dir = out.map(|o| o.to_path_buf()).unwrap_or_else(|| default_out_dir(problem));
     // the folder is this run's until the last mesh is solved (the runs below claim it again)
-    std::fs::create_dir_all(&out_dir).map_err(|e| StampError::io(&out_dir, e))?;
-    let _lock = super::folder_lock::FolderLock::acquire(&out_dir)?;
+    let _lock = super::parallel::on_writer(|| {
+        std::fs::create_dir_all(&out_dir).map_err(|e| StampError::io(&out_dir, e))?;
+        super::folder_lock::FolderLock::acquire(&out_dir)
+    })?;
     let units = Units::new(p.spec.units.as_ref());
     let force_driven: Vec<bool> = p.spec.punch.iter().map(|s| s.get_ref().force.is_some()).collect();
     let mut meshes = vec![mesh_entry(0, &setup.mesh)];
@@ -117,8 +124,10 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
     let mut previous_mesh = setup.mesh.mesh.clone();
     let opts = SolveOptions { quiet, no_table: true, targets: None, refinement: Some(running), caller_finishes: true, record_states: true, previous: None, ..Default::default() };
     let coarse = solve_and_write(&p, setup, &out_dir, &opts);
-    for w in super::check::after_the_run(&p, &out_dir.join("summary.json")) {
-        eprintln!("warning: {w}");
+    if super::parallel::writes_outputs() {
+        for w in super::check::after_the_run(&p, &out_dir.join("summary.json")) {
+            eprintln!("warning: {w}");
+        }
     }
     let mut coarse = match coarse {
         Ok(c) => c,
@@ -185,7 +194,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
             return Err(e);
         }
     };
-    write_string_atomically(&out_dir.join("history.csv"), &rep.csv(&coarse.history))?;
+    super::parallel::on_writer(|| write_string_atomically(&out_dir.join("history.csv"), &rep.csv(&coarse.history)))?;
     let mut object = refinement("converged".into(), &meshes);
     object["order"] = json!(rep.assumed_order());
     object["quantities"] = json!(rep.quantities.iter().map(|q| q.key.clone()).collect::<Vec<_>>());
@@ -196,7 +205,7 @@ pub fn run_refined(problem: &Path, out: Option<&Path>, quiet: bool, levels: usiz
         v["refinement"] = object;
         v["refinement"]["seconds"] = json!(seconds);
     })?;
-    if !quiet {
+    if !quiet && super::parallel::writes_outputs() {
         crate::out!("{}", super::table::render(&coarse.history, &units));
         crate::out!("{}", rep.tables(&coarse.history));
         crate::outln!("{}", explanation(levels));

@@ -25,7 +25,10 @@ use std::time::Instant;
 pub struct RunOutcome {
     pub out_dir: PathBuf,
     pub summary: PathBuf,
+    /// The steps summary.json lists as converged (0 on the ranks that write nothing, see
+    /// [`super::parallel::writes_outputs`]).
     pub converged_steps: usize,
+    /// The files written (none on the ranks that write nothing).
     pub files: Vec<PathBuf>,
     /// The converged steps' punch forces, travels and deflections.
     pub history: History,
@@ -296,8 +299,9 @@ pub fn default_out_dir(problem: &Path) -> PathBuf {
 pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOptions) -> Result<RunOutcome> {
     let quiet = opts.quiet;
     let start = Instant::now();
-    std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
-    super::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
+    // under MPI only rank 0 writes (and prints the table); the others skip every file, and a
+    // failed write is agreed over the ranks (parallel::on_writer) or stops them after the step
+    let writer = super::parallel::writes_outputs();
     // from here on Ctrl-C and SIGTERM abandon the step in progress (see interrupt.rs): a signal
     // that comes before the solve ends it at its first iteration
     let interrupt = match &opts.interrupt {
@@ -305,7 +309,11 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         None => super::interrupt::install(),
     };
     // removes the previous run's files; records this run's when dropped (see out_dir.rs)
-    let _folder = super::out_dir::RunFolder::claim(out_dir)?;
+    let _folder = super::parallel::on_writer(|| {
+        std::fs::create_dir_all(out_dir).map_err(|e| StampError::io(out_dir, e))?;
+        super::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
+        super::out_dir::RunFolder::claim(out_dir)
+    })?;
     let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
     let targets = opts.targets.clone().unwrap_or(targets);
     // the step budget of the path (a refined run passes through the targets it is given)
@@ -428,13 +436,18 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let mut write_error: Option<StampError> = None;
     let mut total_iterations = 0;
     let mut total_failed = 0;
-    // room for the final summary.json, whatever fills the disk meanwhile
-    let mut reserve = super::reserve::Reserve::create(out_dir)?;
-    // a reader sees "running" (with our pid) from the start
-    reserve.cover(write_summary(&summary_path, &summary, None)?);
+    // room for the final summary.json, whatever fills the disk meanwhile; a reader sees
+    // "running" (with our pid) from the start
+    let mut reserve = super::parallel::on_writer(|| {
+        let mut reserve = super::reserve::Reserve::create(out_dir)?;
+        reserve.cover(write_summary(&summary_path, &summary, None)?);
+        Ok(reserve)
+    })?;
     // what summary.json says if the process aborts from here on (see abort_note.rs)
-    let abort_note = super::abort_note::AbortNote::new();
-    abort_note.prepare(&summary_path, aborted(&summary));
+    let abort_note = writer.then(super::abort_note::AbortNote::new);
+    if let Some(note) = &abort_note {
+        note.prepare(&summary_path, aborted(&summary));
+    }
 
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
@@ -454,8 +467,12 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         }
         super::coarse::predict_from(&mut newton, path);
         summary.coarse_predictor = Some(report);
-        reserve.cover(write_summary(&summary_path, &summary, None)?);
-        abort_note.prepare(&summary_path, aborted(&summary));
+        if let Some(bytes) = super::parallel::on_writer(|| write_summary(&summary_path, &summary, None))? {
+            reserve.as_mut().map(|r| r.cover(bytes));
+        }
+        if let Some(note) = &abort_note {
+            note.prepare(&summary_path, aborted(&summary));
+        }
     }
     newton.on_iteration = progress.callback();
     // a failed output write ends the run after its step (what follows could not be written)
@@ -501,7 +518,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
         let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u).clone();
         progress.step(rep, path_len, active, penetration, &history.terse_forces());
-        if write_error.is_some() {
+        if write_error.is_some() || !writer {
             return;
         }
         if let Err(e) = history.write_csv(out_dir) {
@@ -565,8 +582,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             summary.seconds = start.elapsed().as_secs_f64();
             // a failed write here is retried at the end (with the failure)
             write_summary(&summary_path, &summary, None).map(|bytes| {
-                reserve.cover(bytes);
-                abort_note.prepare(&summary_path, aborted(&summary));
+                reserve.as_mut().map(|r| r.cover(bytes));
+                if let Some(note) = &abort_note {
+                    note.prepare(&summary_path, aborted(&summary));
+                }
             })
         });
         if let Some(kept) = kept.as_mut().filter(|_| listed) {
@@ -624,13 +643,16 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     // the first error decides the status: a write failure stopped the outputs, a solve failure the
     // run; the .pvd and the plots are written either way (they list the written steps)
     let mut failure: Option<StampError> = write_error.or(solve_failure);
-    if out.vtu {
+    if out.vtu && writer {
         match write_pvd(&pvd_path, &pvd) {
             Ok(()) => files.push(pvd_path),
             Err(e) => failure = failure.or(Some(e)),
         }
     }
     let finals: Result<()> = (|| {
+        if !writer {
+            return Ok(());
+        }
         files.push(history.write_csv(out_dir)?);
         if out.plot {
             files.extend(history.plot_force_travel(out_dir, &units)?);
@@ -641,7 +663,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     if let Err(e) = finals {
         failure = failure.or(Some(e));
     }
-    if !quiet && (!opts.no_table || failure.is_some()) {
+    if writer && !quiet && (!opts.no_table || failure.is_some()) {
         crate::out!("{}", super::table::render(&history, &units));
     }
     summary.seconds = start.elapsed().as_secs_f64();
@@ -659,13 +681,19 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             summary.error = Some(e.to_string());
         }
     }
-    abort_note.withdraw();
-    write_final_summary(&summary_path, &summary, failure.as_ref(), &mut reserve)?;
+    if let Some(note) = &abort_note {
+        note.withdraw();
+    }
+    super::parallel::on_writer(|| reserve.as_mut().map_or(Ok(()), |r| write_final_summary(&summary_path, &summary, failure.as_ref(), r)))?;
     drop(reserve);
-    files.push(summary_path.clone());
+    if writer {
+        files.push(summary_path.clone());
+    }
     let converged_steps = summary.steps.iter().filter(|s| s["converged"] == serde_json::Value::Bool(true)).count();
-    match failure {
+    // the same outcome on every rank (a write that failed on rank 0 fails them all), so that a
+    // caller going on to more collective work (--refine) goes on, or stops, on every rank
+    super::parallel::agree(match failure {
         Some(e) => Err(e),
         None => Ok(RunOutcome { out_dir: out_dir.to_path_buf(), summary: summary_path, converged_steps, files, history, states, kept }),
-    }
+    })
 }
