@@ -117,6 +117,48 @@ else
   bad "a bad problem file on 4 ranks: $(cat "$work/bad.err")"
 fi
 
+# Ctrl-C under mpirun: a longer run (sphere-ss on 80 x 80) on 2 ranks, signalled once its solve is
+# under way. (1) SIGINT to mpirun, which sends every rank SIGTERM and SIGKILL a second later: the
+# job ends within seconds, summary.json says "interrupted" (written at the signal if the ranks
+# are killed before they end the run), no rank is left. (2) SIGINT to rank 1 alone: the ranks
+# agree at Newton's next check and end cleanly, one message, exit status 130 (mpirun's too).
+sed 's/n = \[10, 10\]/n = [80, 80]/' meshes/sphere-ss.toml >"$work/long.toml"
+interrupt_case() { # $1: case name, $2: "mpirun" or "rank1"
+  local out="$work/sig-$1" pid child r1="" t0 code
+  "${mpirun[@]}" -n 2 "$stamp" run "$work/long.toml" --out "$out" -q 2>"$out.err" &
+  pid=$!
+  t0=$SECONDS
+  until grep -qs '"running"' "$out/summary.json" || [ $((SECONDS - t0)) -gt 120 ]; do sleep 0.2; done
+  sleep 2
+  if [ "$2" = mpirun ]; then
+    kill -INT "$pid"
+  else
+    for child in $(pgrep -P "$pid"); do
+      tr '\0' '\n' <"/proc/$child/environ" 2>/dev/null | grep -qx OMPI_COMM_WORLD_RANK=1 && r1=$child
+    done
+    [ -n "$r1" ] && kill -INT "$r1"
+  fi
+  t0=$SECONDS
+  while kill -0 "$pid" 2>/dev/null && [ $((SECONDS - t0)) -lt 60 ]; do sleep 0.2; done
+  if kill -0 "$pid" 2>/dev/null; then
+    kill -KILL "$pid"; bad "Ctrl-C ($1): the job did not end within 60 s"; return
+  fi
+  wait "$pid" && code=0 || code=$?
+  local status
+  status=$(python3 -c "import json; s=json.load(open('$out/summary.json')); print(s['status'], s['ranks'])" 2>&1)
+  if pgrep -f "$out" >/dev/null; then
+    bad "Ctrl-C ($1): a rank is left running"
+  elif [ "$status" != "interrupted 2" ]; then
+    bad "Ctrl-C ($1): summary.json says $status; $(cat "$out.err")"
+  elif [ "$2" = rank1 ] && { [ "$code" != 130 ] || [ "$(grep -c '^error: interrupted' "$out.err")" != 1 ] || ! grep -q 'SIGINT' "$out/summary.json"; }; then
+    bad "Ctrl-C ($1): exit status $code; $(cat "$out.err")"
+  else
+    echo "Ctrl-C ($1): the job ended $((SECONDS - t0)) s after the signal, exit status $code"; ok
+  fi
+}
+interrupt_case mpirun mpirun
+interrupt_case rank1 rank1
+
 echo "petsc: $((SECONDS - start)) s"
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

@@ -315,6 +315,12 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// Newton iteration; `solve_path` then returns [`StampError::Interrupted`] with `u` at the
     /// last converged state.
     pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// For a solve that several processes run together in lockstep (a model shared over MPI
+    /// ranks, see [`crate::share`]): called with this process's [`interrupt`](Self::interrupt)
+    /// flag at every check of it, returns whether any process's is set (a collective call), so
+    /// that a signal that reached some processes, or reached them at different iterations, ends
+    /// every process at the same check. None: the flag alone.
+    pub agree_interrupt: Option<Box<dyn Fn(bool) -> bool>>,
     /// The start of each load step, when given: called with (converged steps so far, load factor
     /// of the last converged state, load factor of the step, the start to set); true when it set
     /// the start (then used instead of the secant extrapolation, see
@@ -328,7 +334,7 @@ pub struct NewtonRaphson<L: LinearSolver> {
 
 impl<L: LinearSolver> NewtonRaphson<L> {
     pub fn new(linear: L, settings: NewtonSettings) -> Self {
-        NewtonRaphson { settings, linear, on_iteration: None, stop: None, interrupt: None, predictor: None, iterations_done: 0 }
+        NewtonRaphson { settings, linear, on_iteration: None, stop: None, interrupt: None, agree_interrupt: None, predictor: None, iterations_done: 0 }
     }
 
     /// Newton iterations done so far by this solver, those of attempts that failed included (a
@@ -362,9 +368,14 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         })
     }
 
-    /// Whether [`interrupt`](Self::interrupt) was set.
+    /// Whether [`interrupt`](Self::interrupt) was set (on any process, with
+    /// [`agree_interrupt`](Self::agree_interrupt)).
     fn interrupted(&self) -> bool {
-        self.interrupt.as_ref().is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+        let local = self.interrupt.as_ref().is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
+        match &self.agree_interrupt {
+            Some(agree) => agree(local),
+            None => local,
+        }
     }
 
     /// Newton iterations at fixed load factor `t` starting from `u`. Returns the residual history
@@ -1001,6 +1012,31 @@ mod tests {
         assert!(matches!(e, StampError::Interrupted { steps: 0, load_factor: 0.0 }), "{e}");
         assert!(steps.is_empty() && u[0] == 0.0, "{steps:?} {u:?}");
         assert!(e.to_string().contains("interrupted after load step 0"), "{e}");
+    }
+
+    /// With `agree_interrupt`, an interrupt set on another process only (the hook says so at
+    /// the third check) ends this one's path at that check too, and every check asks the hook,
+    /// flag or no flag.
+    #[test]
+    fn an_interrupt_agreed_with_other_processes_ends_the_path_at_the_same_check() {
+        let mut p = Line::new();
+        let mut u = [0.0];
+        let mut newton = NewtonRaphson::new(SparseLu::new(), settings());
+        let checks = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let c = checks.clone();
+        newton.agree_interrupt = Some(Box::new(move |local| {
+            assert!(!local, "no flag on this process");
+            c.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1 >= 3
+        }));
+        let mut steps = Vec::new();
+        let e = newton.solve_path(&mut p, &mut u, 0.0, &[0.25, 0.5], &mut |r, _, _| steps.push(r.load_factor)).unwrap_err();
+        assert!(matches!(e, StampError::Interrupted { steps: 0, load_factor: 0.0 }), "{e}");
+        // before the step, iterations 0 and 1 (interrupted), and after the abandoned attempt
+        assert_eq!(checks.load(std::sync::atomic::Ordering::Relaxed), 4);
+        assert!(steps.is_empty() && u[0] == 0.0, "{steps:?} {u:?}");
+        // without the hook's say the same path converges
+        let (mut p, mut u) = (Line::new(), [0.0]);
+        NewtonRaphson::new(SparseLu::new(), settings()).solve_path(&mut p, &mut u, 0.0, &[0.25, 0.5], &mut |_, _, _| {}).unwrap();
     }
 
     #[test]

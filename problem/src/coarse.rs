@@ -82,6 +82,7 @@ pub fn solve_coarse(coarse: CoarseSetup, targets: &[f64]) -> (CoarsePath, Coarse
     path.record(0.0, &u);
     let mut newton = NewtonRaphson::new(BorderedSolver::new(model.num_drives()), settings);
     newton.interrupt = super::interrupt::install();
+    newton.agree_interrupt = super::parallel::agreed_interrupt();
     // counted per converged step: a failed solve returns no summary
     let (mut iterations, mut cutbacks) = (0, 0);
     let result = newton.solve_path(&mut model, &mut u, 0.0, targets, &mut |rep, u, _| {

@@ -3,7 +3,11 @@
 //! ([`stamp::nonlinear::NewtonRaphson::interrupt`]); the step in progress is abandoned, the
 //! converged steps stay written, summary.json says "interrupted" and the program exits with
 //! 128 + the signal's number (130, 143), as a shell reports a process ended by it. A second
-//! signal while the first is being handled ends the program at once.
+//! signal while the first is being handled ends the program at once. The program's handlers also
+//! write summary.json's "interrupted" note at once ([`super::abort_note`]): a process may be
+//! killed before it ends the run (mpirun sends SIGKILL a second after the SIGTERM it sends every
+//! rank). Under MPI the ranks agree on the signal ([`super::parallel::agreed_interrupt`], which
+//! records it with [`note`] on the ranks it did not reach).
 
 use signal_hook::consts::{SIGINT, SIGTERM};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -51,10 +55,24 @@ fn init(signals: &[i32], exit_on_second: bool) -> Option<Arc<AtomicBool>> {
             }
             signal_hook::flag::register_usize(sig, flags.which.clone(), sig as usize).ok()?;
             signal_hook::flag::register(sig, flags.any.clone()).ok()?;
+            if exit_on_second {
+                // SAFETY: the action only calls async-signal-safe functions (see abort_note.rs)
+                unsafe { signal_hook::low_level::register(sig, move || super::abort_note::on_interrupt(sig)) }.ok()?;
+            }
         }
         Some(flags)
     });
     flags.as_ref().map(|f| f.any.clone())
+}
+
+/// Record `signal` as received (another rank of a distributed run received it, see
+/// [`super::parallel::agreed_interrupt`]): this process then ends as if it had, with the same
+/// status. Nothing without the handlers.
+pub fn note(signal: i32) {
+    if let Some(Some(flags)) = FLAGS.get() {
+        flags.which.store(signal as usize, Ordering::Relaxed);
+        flags.any.store(true, Ordering::Relaxed);
+    }
 }
 
 /// The signal received, if any (SIGINT or SIGTERM).

@@ -100,6 +100,31 @@ pub fn on_writer<T>(write: impl FnOnce() -> Result<T>) -> Result<Option<T>> {
     agree(if writes_outputs() { write().map(Some) } else { Ok(None) })
 }
 
+/// For Newton's interrupt checks on P > 1 ranks ([`stamp::nonlinear::NewtonRaphson::agree_interrupt`]):
+/// the largest signal any rank received (MPI_Allreduce at every check, which every rank makes at
+/// the same point of the same iterations), recorded on the ranks it did not reach
+/// ([`super::interrupt::note`]), so that every rank abandons the step at the same check and ends
+/// with the same status. None on one rank.
+pub fn agreed_interrupt() -> Option<Box<dyn Fn(bool) -> bool>> {
+    #[cfg(feature = "petsc")]
+    if let Some(p) = stamp_petsc::Petsc::current() {
+        if p.size() > 1 {
+            return Some(Box::new(move |local| {
+                // a flag set with no signal recorded counts as 1
+                let mut v = [if local { super::interrupt::received().map_or(1, |s| s as u64) } else { 0 }];
+                if p.max_u64(&mut v).is_err() {
+                    return local;
+                }
+                if v[0] > 1 && super::interrupt::received().is_none() {
+                    super::interrupt::note(v[0] as i32);
+                }
+                v[0] > 0
+            }));
+        }
+    }
+    None
+}
+
 /// On P > 1 ranks, share the model over them (see `stamp::share`): METIS splits the elements
 /// into P parts, each rank evaluates only its own, and each node (its equations, its contact and
 /// follower-load tangent rows) belongs to the rank of the lowest-numbered element around it; the

@@ -213,6 +213,30 @@ fn aborted(summary: &Summary) -> String {
     serde_json::to_string_pretty(&v).unwrap_or_default()
 }
 
+/// The error of an interrupted run as summary.json says it: "interrupted by SIGINT (Ctrl-C) after
+/// load step ...".
+fn interrupted_message(e: &StampError, signal: Option<i32>) -> String {
+    let by = signal.map(|s| format!("interrupted by {}", super::interrupt::name(s))).unwrap_or_else(|| "interrupted".into());
+    e.to_string().replacen("interrupted", &by, 1)
+}
+
+/// summary.json as it would be if `signal` ended the run now, after `steps` converged steps (the
+/// last at `load_factor`): "interrupted", with the steps listed so far.
+fn interrupted(summary: &Summary, signal: i32, steps: usize, load_factor: f64) -> String {
+    let mut v = serde_json::to_value(summary).unwrap_or_default();
+    v["status"] = "interrupted".into();
+    v["error"] = interrupted_message(&StampError::Interrupted { steps, load_factor }, Some(signal)).into();
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// Keep summary.json's notes ready (see abort_note.rs) after `steps` converged steps, the last at
+/// `load_factor`: "failed" for an abort, "interrupted" for SIGINT and SIGTERM.
+fn prepare_notes(note: Option<&super::abort_note::AbortNote>, path: &Path, summary: &Summary, steps: usize, load_factor: f64) {
+    if let Some(note) = note {
+        note.prepare(path, aborted(summary), |signal| interrupted(summary, signal, steps, load_factor));
+    }
+}
+
 /// The progress bar: the load path along the bar, Newton iteration and residual in the message.
 /// Without a terminal (and without --quiet) one terse line per converged step on stderr.
 struct Progress {
@@ -443,11 +467,10 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         reserve.cover(write_summary(&summary_path, &summary, None)?);
         Ok(reserve)
     })?;
-    // what summary.json says if the process aborts from here on (see abort_note.rs)
+    // what summary.json says if the process aborts or is interrupted from here on (see
+    // abort_note.rs)
     let abort_note = writer.then(super::abort_note::AbortNote::new);
-    if let Some(note) = &abort_note {
-        note.prepare(&summary_path, aborted(&summary));
-    }
+    prepare_notes(abort_note.as_ref(), &summary_path, &summary, 0, 0.0);
 
     let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
@@ -470,15 +493,14 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         if let Some(bytes) = super::parallel::on_writer(|| write_summary(&summary_path, &summary, None))? {
             reserve.as_mut().map(|r| r.cover(bytes));
         }
-        if let Some(note) = &abort_note {
-            note.prepare(&summary_path, aborted(&summary));
-        }
+        prepare_notes(abort_note.as_ref(), &summary_path, &summary, 0, 0.0);
     }
     newton.on_iteration = progress.callback();
     // a failed output write ends the run after its step (what follows could not be written)
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     newton.stop = Some(stop.clone());
     newton.interrupt = interrupt;
+    newton.agree_interrupt = super::parallel::agreed_interrupt();
     let mut u = vec![0.0; model.num_dofs()];
     let (mut path_len, mut t_last) = (0.0, 0.0);
     let mut surface_error: Option<StampError> = None;
@@ -517,6 +539,8 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         let penetration = m.contacts.iter().map(|c| c.max_penetration()).fold(0.0, f64::max);
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
         let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u).clone();
+        // an interrupt from here on says this step converged, whether or not it is written
+        prepare_notes(abort_note.as_ref(), &summary_path, &summary, rep.step, t);
         progress.step(rep, path_len, active, penetration, &history.terse_forces());
         if write_error.is_some() || !writer {
             return;
@@ -583,9 +607,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             // a failed write here is retried at the end (with the failure)
             write_summary(&summary_path, &summary, None).map(|bytes| {
                 reserve.as_mut().map(|r| r.cover(bytes));
-                if let Some(note) = &abort_note {
-                    note.prepare(&summary_path, aborted(&summary));
-                }
+                prepare_notes(abort_note.as_ref(), &summary_path, &summary, rep.step, t);
             })
         });
         if let Some(kept) = kept.as_mut().filter(|_| listed) {
@@ -673,8 +695,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         None => summary.status = "converged".into(),
         Some(e @ StampError::Interrupted { .. }) => {
             summary.status = "interrupted".into();
-            let by = super::interrupt::received().map(|s| format!("interrupted by {}", super::interrupt::name(s))).unwrap_or_else(|| "interrupted".into());
-            summary.error = Some(e.to_string().replacen("interrupted", &by, 1));
+            summary.error = Some(interrupted_message(e, super::interrupt::received()));
         }
         Some(e) => {
             summary.status = "failed".into();
