@@ -45,10 +45,10 @@ pub struct Model<E: Element> {
     /// Augmented-Lagrangian tolerance on the penetration (a length; see
     /// [`ContactPair::constraint_violation`]); `None` for the plain perturbed Lagrangian.
     pub augmented_tolerance: Option<f64>,
+    /// The nodal pattern, bordered by the force-driven punches' rows and columns when there are
+    /// any (the nodal one is not kept beside it: a pattern can be 0.4 GB; see
+    /// [`SparsePattern::unbordered`]).
     pattern: SparsePattern,
-    /// The nodal pattern (without the force-driven punches' border) while `pattern` is bordered;
-    /// None while `pattern` is the nodal one (no copy of a pattern that can be 0.4 GB).
-    nodal_pattern: Option<SparsePattern>,
     /// Per force-driven punch: (index in `contacts`, number of candidate points) the pattern was
     /// bordered for.
     border: Vec<(usize, usize)>,
@@ -73,6 +73,9 @@ pub struct Model<E: Element> {
     /// This process's share of a model evaluated by several (see [`crate::share`]); None: the
     /// whole model.
     share: Option<Share>,
+    /// With a share: the elements whose entries the pattern holds (its own, and every element
+    /// around a node it owns, so that the rows of its nodes are whole); None: every element.
+    pattern_elements: Option<Vec<bool>>,
     /// The tangent's reference state (see [`Element::evaluate_about`]): the nodal dofs of the
     /// last evaluation with a tangent, or of the last converged state at the start of a step;
     /// empty: every tangent is the exact derivative at its iterate.
@@ -115,7 +118,6 @@ impl<E: Element> Model<E> {
             follower_loads: Vec::new(),
             follower_force: Vec::new(),
             augmented_tolerance: None,
-            nodal_pattern: None,
             pattern,
             border: Vec::new(),
             coupled: Vec::new(),
@@ -126,6 +128,7 @@ impl<E: Element> Model<E> {
             peak_scale: 0.0,
             timings: ModelTimings::default(),
             share: None,
+            pattern_elements: None,
             reference: Vec::new(),
             last_u: Vec::new(),
             converged_u: Vec::new(),
@@ -180,19 +183,8 @@ impl<E: Element> Model<E> {
     fn sync_drives(&mut self) {
         let coupled: Vec<(usize, u64)> = self.contacts.iter().enumerate().filter(|(_, c)| c.face().is_some()).map(|(i, c)| (i, c.coupling_version())).collect();
         if coupled != self.coupled {
-            let groups: Vec<Vec<usize>> = coupled.iter().flat_map(|&(i, _)| self.contacts[i].coupled_nodes()).collect();
-            let element = &self.element;
-            let nodal = SparsePattern::coupled(&self.dofs, element.num_elements(), element.nodes_per_element(), |e| element.element_nodes(e).to_vec(), &groups)
-                .expect("the element pattern was built before; contact points are nodes of the model");
-            self.nodal_pattern = None;
-            self.pattern = nodal;
             self.coupled = coupled;
-            // border again below, and size the values
-            self.border.clear();
-            self.values = vec![0.0; self.pattern.nnz()];
-            if !self.preconditioner.is_empty() {
-                self.preconditioner = vec![0.0; self.pattern.nnz()];
-            }
+            self.rebuild_pattern();
         }
         let nd = self.dofs.num_dofs();
         let mut sig = Vec::new();
@@ -205,19 +197,42 @@ impl<E: Element> Model<E> {
         if sig == self.border {
             return;
         }
+        // the nodal pattern: the present one, without its border if it has one
+        let unbordered = (!self.border.is_empty()).then(|| self.pattern.unbordered(self.dofs.num_equations()));
         if sig.is_empty() {
-            if let Some(nodal) = self.nodal_pattern.take() {
+            if let Some(nodal) = unbordered {
                 self.pattern = nodal;
             }
         } else {
             let border: Vec<Vec<usize>> = sig.iter().map(|&(i, _)| self.contacts[i].points.iter().flat_map(|p| p.dofs).collect()).collect();
-            let nodal = self.nodal_pattern.get_or_insert_with(|| self.pattern.clone());
-            self.pattern = nodal.bordered(&self.dofs, &border);
+            self.pattern = unbordered.as_ref().unwrap_or(&self.pattern).bordered(&self.dofs, &border);
         }
         self.border = sig;
         let nb = self.border.len();
         self.force.resize(nd + nb, 0.0);
         self.residual.resize(self.dofs.num_equations() + nb, 0.0);
+        self.values = vec![0.0; self.pattern.nnz()];
+        if !self.preconditioner.is_empty() {
+            self.preconditioner = vec![0.0; self.pattern.nnz()];
+        }
+    }
+
+    /// Build the nodal pattern again (the elements of [`pattern_elements`](Self::pattern_elements)
+    /// and the integrated punches' couplings of `coupled`); the border follows in
+    /// [`sync_drives`](Self::sync_drives), and the values are sized anew.
+    fn rebuild_pattern(&mut self) {
+        let groups: Vec<Vec<usize>> = self.coupled.iter().flat_map(|&(i, _)| self.contacts[i].coupled_nodes()).collect();
+        let element = &self.element;
+        let nodes = |e: usize| element.element_nodes(e).to_vec();
+        let (ne, npe) = (element.num_elements(), element.nodes_per_element());
+        let nodal = match &self.pattern_elements {
+            None => SparsePattern::coupled(&self.dofs, ne, npe, nodes, &groups),
+            Some(subset) => SparsePattern::coupled_subset(&self.dofs, ne, npe, nodes, &groups, subset),
+        }
+        .expect("the element pattern was built before; contact points are nodes of the model");
+        self.pattern = nodal;
+        // border again in sync_drives, and size the values
+        self.border.clear();
         self.values = vec![0.0; self.pattern.nnz()];
         if !self.preconditioner.is_empty() {
             self.preconditioner = vec![0.0; self.pattern.nnz()];
@@ -236,7 +251,10 @@ impl<E: Element> Model<E> {
 
     /// Evaluate only this process's share of the model from now on (see [`crate::share`]: its
     /// elements, and the contact and displacement-dependent-load tangent rows of its nodes, with
-    /// the forces and energy summed over the processes); None: the whole model again.
+    /// the forces and energy summed over the processes); None: the whole model again. The
+    /// sparse pattern and its value arrays shrink to the share's entries: those of its own
+    /// elements and the whole rows of its own nodes (every element around them), the rows and
+    /// columns of the force-driven punches whole.
     pub fn set_share(&mut self, share: Option<Share>) -> Result<()> {
         let (ne, nn) = (self.element.num_elements(), self.dofs.num_nodes());
         self.assembler = match &share {
@@ -251,7 +269,17 @@ impl<E: Element> Model<E> {
             }
             None => Assembler::new(&self.element, nn),
         };
+        self.pattern_elements = share.as_ref().map(|s| {
+            let mut taken = vec![false; ne];
+            s.elements.iter().for_each(|&e| taken[e] = true);
+            for (e, t) in taken.iter_mut().enumerate() {
+                *t = *t || self.element.element_nodes(e).iter().any(|&n| s.owned_nodes[n]);
+            }
+            taken
+        });
         self.share = share;
+        self.rebuild_pattern();
+        self.sync_drives();
         Ok(())
     }
 

@@ -11,7 +11,10 @@
 //! construction); each process adds only the tangent rows of the nodes it owns. So the sparse
 //! tangent and preconditioner values a process holds are its share of the nodal block (the sum
 //! over the processes is the whole matrix: a distributed solver adds them), while the rows and
-//! columns of the force-driven punches' unknowns are whole on every process.
+//! columns of the force-driven punches' unknowns are whole on every process. The pattern a
+//! process holds is its own (its value arrays are sized to it): the entries of its elements and
+//! of every element around a node it owns (so the rows of its nodes are whole: a distributed
+//! solver preallocates them from it), with the force-driven punches' rows and columns.
 
 use crate::error::Result;
 use std::sync::Arc;

@@ -2,8 +2,9 @@
 //! for three processes, with a reduction over them. At a large-displacement state with points in
 //! contact with a force-driven punch and a follower pressure, every share's residual, energy and
 //! contact state are the whole model's, the shares' tangents and preconditioners add up to the
-//! whole model's in the nodal block, and the punch's row and column are whole in every share. An
-//! element that refuses the state on one share gives every share the same error.
+//! whole model's in the nodal block, and the punch's row and column are whole in every share.
+//! Each share's pattern is its own, smaller than the whole's, and holds the whole rows of the
+//! nodes it owns. An element that refuses the state on one share gives every share the same error.
 
 mod common;
 use common::*;
@@ -17,6 +18,7 @@ use stamp::nonlinear::NonlinearProblem;
 use stamp::share::{Reduce, Share};
 use stamp_contact::Sphere;
 use stamp_elements::{Face, FollowerPressure, Kinematics, PlateElements};
+use std::collections::BTreeMap;
 use std::sync::{Arc, Barrier, Mutex};
 
 /// Sums and minima over `n` threads: each adds its entries into a common buffer, all wait, all
@@ -86,21 +88,30 @@ fn model(mesh: &QuadMesh) -> Model<PlateElements> {
     model
 }
 
-/// (residual, energy, active flags, tangent values, preconditioner values) at `u`, or the error.
-type Outcome = std::result::Result<(Vec<f64>, f64, Vec<bool>, Vec<f64>, Vec<f64>), String>;
+/// A sparse matrix's stored entries (zeros too), (row, column) -> value.
+type Entries = BTreeMap<(usize, usize), f64>;
+
+/// (residual, energy, active flags, tangent, preconditioner) at `u`, or the error.
+type Outcome = std::result::Result<(Vec<f64>, f64, Vec<bool>, Entries, Entries), String>;
+
+fn entries(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Entries {
+    let (cp, ri) = (m.symbolic().col_ptr(), m.symbolic().row_idx());
+    (0..m.ncols()).flat_map(|j| (cp[j]..cp[j + 1]).map(move |k| ((ri[k], j), k))).map(|(ij, k)| (ij, m.val()[k])).collect()
+}
 
 fn evaluate(model: &mut Model<PlateElements>, u: &[f64]) -> Outcome {
     model.evaluate(u, 1.0, true).map_err(|e| e.to_string())?;
     let active = model.contacts[0].state.iter().map(|s| s.active).collect();
-    Ok((model.residual().to_vec(), model.energy(), active, model.matrix().val().to_vec(), model.preconditioner().unwrap().val().to_vec()))
+    Ok((model.residual().to_vec(), model.energy(), active, entries(model.matrix()), entries(model.preconditioner().unwrap())))
 }
 
-fn shared(mesh: &QuadMesh, u: &[f64]) -> Vec<Outcome> {
+/// Each share's outcome at `u`, and the owner of every node.
+fn shared(mesh: &QuadMesh, u: &[f64]) -> (Vec<Outcome>, Vec<u32>) {
     let cells = |e: usize| mesh.cells[e].to_vec();
     let part = partition_elements(mesh.num_nodes(), mesh.num_cells(), cells, PARTS).unwrap();
     let owner = node_owners(mesh.num_nodes(), mesh.num_cells(), cells, &part);
     let reduce = Arc::new(Threads { barrier: Barrier::new(PARTS), sum: Mutex::new(Vec::new()), min: Mutex::new(Vec::new()) });
-    std::thread::scope(|s| {
+    let outcomes = std::thread::scope(|s| {
         let handles: Vec<_> = (0..PARTS as u32)
             .map(|k| {
                 let share = Share {
@@ -116,7 +127,8 @@ fn shared(mesh: &QuadMesh, u: &[f64]) -> Vec<Outcome> {
             })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()
-    })
+    });
+    (outcomes, owner)
 }
 
 #[test]
@@ -141,39 +153,52 @@ fn shares_add_up_to_the_whole_model() {
     let (r, energy, active, k, p) = evaluate(&mut whole, &u).unwrap();
     assert!(active.iter().filter(|a| **a).count() >= 3, "points in contact: {}", active.iter().filter(|a| **a).count());
     let scale = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let kscale = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let outcomes = shared(&mesh, &u);
-    let (mut ks, mut ps) = (vec![0.0; k.len()], vec![0.0; p.len()]);
+    let kscale = k.values().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (outcomes, owner) = shared(&mesh, &u);
+    let (mut ks, mut ps): (Entries, Entries) = (BTreeMap::new(), BTreeMap::new());
     let neq = whole.num_equations();
-    let pattern = whole.pattern();
+    let border = neq - 1;
+    // the node of each nodal equation
+    let mut node_of = vec![usize::MAX; neq];
+    for d in 0..whole.dofs.num_dofs() {
+        if let Some(e) = whole.dofs.equation(d) {
+            node_of[e] = d / 6;
+        }
+    }
     for (i, o) in outcomes.iter().enumerate() {
         let (ri, ei, ai, ki, pi) = o.as_ref().unwrap();
         let dr = r.iter().zip(ri).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(dr <= 1e-12 * scale, "share {i}: residual differs by {dr:e} of {scale:e}");
         assert!((ei - energy).abs() <= 1e-12 * energy.abs(), "share {i}: energy {ei} against {energy}");
         assert_eq!(ai, &active, "share {i}: active set");
-        ks.iter_mut().zip(ki).for_each(|(s, v)| *s += v);
-        ps.iter_mut().zip(pi).for_each(|(s, v)| *s += v);
+        // a pattern of its own: within the whole's, smaller, with the whole rows of its nodes
+        assert!(ki.keys().all(|ij| k.contains_key(ij)), "share {i}: an entry outside the whole pattern");
+        assert!(ki.keys().eq(pi.keys()), "share {i}: the preconditioner's pattern is the tangent's");
+        assert!(ki.len() < k.len() * 3 / 4, "share {i}: {} entries of the whole's {}", ki.len(), k.len());
+        for &(a, b) in k.keys() {
+            if a != border && owner[node_of[a]] == i as u32 {
+                assert!(ki.contains_key(&(a, b)), "share {i}: entry ({a}, {b}) of a row it owns is missing");
+            }
+        }
+        for (ij, v) in ki {
+            *ks.entry(*ij).or_default() += v;
+        }
+        for (ij, v) in pi {
+            *ps.entry(*ij).or_default() += v;
+        }
         // the punch's row and column are whole in every share
-        let border = neq - 1;
-        for j in 0..neq {
-            for (a, b) in [(border, j), (j, border)] {
-                if let Some(slot) = pattern.find(a, b) {
-                    assert_eq!(ki[slot], k[slot], "share {i}: entry ({a}, {b}) of the punch's row or column");
-                }
+        for (&(a, b), v) in &k {
+            if a == border || b == border {
+                assert_eq!(ki.get(&(a, b)), Some(v), "share {i}: entry ({a}, {b}) of the punch's row or column");
             }
         }
     }
     // the nodal block: the sum of the shares (the border counted once)
-    let border = neq - 1;
-    for j in 0..neq {
-        for i in 0..neq {
-            if let Some(slot) = pattern.find(i, j) {
-                let (sum_k, sum_p) = if i == border || j == border { (ks[slot] / PARTS as f64, ps[slot] / PARTS as f64) } else { (ks[slot], ps[slot]) };
-                assert!((sum_k - k[slot]).abs() <= 1e-12 * kscale, "tangent ({i}, {j}): shares add to {sum_k}, whole {}", k[slot]);
-                assert!((sum_p - p[slot]).abs() <= 1e-12 * kscale, "preconditioner ({i}, {j}): shares add to {sum_p}, whole {}", p[slot]);
-            }
-        }
+    for (&(i, j), &whole_k) in &k {
+        let parts = if i == border || j == border { PARTS as f64 } else { 1.0 };
+        let (sum_k, sum_p) = (ks[&(i, j)] / parts, ps[&(i, j)] / parts);
+        assert!((sum_k - whole_k).abs() <= 1e-12 * kscale, "tangent ({i}, {j}): shares add to {sum_k}, whole {whole_k}");
+        assert!((sum_p - p[&(i, j)]).abs() <= 1e-12 * kscale, "preconditioner ({i}, {j}): shares add to {sum_p}, whole {}", p[&(i, j)]);
     }
     // an element turned inside out on one share: the same error everywhere
     let mut bad = u.clone();
@@ -182,7 +207,7 @@ fn shares_add_up_to_the_whole_model() {
         bad[face.dof(corner, 0)] = -3.0;
     }
     let want = evaluate(&mut whole, &bad).expect_err("an element refuses");
-    for (i, o) in shared(&mesh, &bad).iter().enumerate() {
+    for (i, o) in shared(&mesh, &bad).0.iter().enumerate() {
         assert_eq!(o.as_ref().expect_err("refused on every share"), &want, "share {i}");
     }
 }

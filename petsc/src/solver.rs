@@ -4,10 +4,11 @@
 //! compressed-column tangent, assembled on every rank) and copies only its own contiguous range
 //! of rows (split evenly by index) into a distributed MPIAIJ matrix. After
 //! [`PetscSolver::set_partition`] each rank is handed only its share (a model evaluated by its own
-//! elements on each rank, `stamp::share`): PETSc's rows are numbered rank after rank by the owner
-//! of each equation, every rank adds the nonzero entries of its share (`ADD_VALUES`: PETSc sends
-//! those of other ranks' rows at the assembly) into the full pattern, which is allocated once and
-//! kept, so MUMPS keeps its symbolic factorisation. Either way the factorisation (MUMPS), the
+//! elements on each rank, `stamp::share`), in a pattern of its own that holds the whole rows the
+//! rank owns: PETSc's rows are numbered rank after rank by the owner of each equation, every rank
+//! adds the nonzero entries of its share (`ADD_VALUES`: PETSc sends those of other ranks' rows at
+//! the assembly) into the pattern of its rows, which is allocated once and kept (built anew on
+//! every rank when any rank's pattern changes), so MUMPS keeps its symbolic factorisation. Either way the factorisation (MUMPS), the
 //! Krylov iterations and their memory are spread over the ranks, and the solution is gathered
 //! onto every rank, so that every rank goes on with the same iterate; a hash of every
 //! right-hand side is compared over the ranks, so that ranks whose replicated states drifted
@@ -115,8 +116,10 @@ impl PetscSolver {
     /// evaluated by its share of the elements on each rank, see `stamp::share`): `owners[i]`, the
     /// rank owning equation i (equations from `owners.len()` on: rank 0), whose rows PETSc keeps
     /// on that rank (numbered rank after rank). Every rank passes the same owners; the right-hand
-    /// sides stay whole on every rank, and so do the solutions. None: every rank hands over the
-    /// whole matrices, split by rows evenly.
+    /// sides stay whole on every rank, and so do the solutions. A rank's matrices may have a
+    /// pattern of their own, as long as it holds every entry of the rows the rank owns (the
+    /// preallocation of its rows) and every nonzero entry of its share. None: every rank hands
+    /// over the whole matrices, split by rows evenly.
     pub fn set_partition(&mut self, owners: Option<Vec<u32>>) {
         self.partition = owners;
         self.setup = None;
@@ -288,6 +291,12 @@ impl PetscSolver {
             Some(s) => s.key != key || s.p.is_some() != p.is_some(),
             None => true,
         };
+        // each rank hands over a pattern of its own (its share's, see set_partition), which may
+        // change on some ranks only: the matrices are built anew on every rank (collective) if
+        // any rank's changed
+        let mut any = [rebuild as u64];
+        self.petsc.max_u64(&mut any)?;
+        let rebuild = any[0] != 0;
         if rebuild {
             let t = Instant::now();
             self.setup = None;

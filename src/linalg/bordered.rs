@@ -31,8 +31,7 @@ pub struct BorderedSolver<S: LinearSolver = LdltGmres> {
     pattern_nnz: usize,
     n0: usize,
     sym11: Option<SymbolicSparseColMat<usize>>,
-    /// Position in the full value array of every entry of A11, in A11's order.
-    map11: Vec<usize>,
+    /// The values of the leading block A11 (see `copy11`).
     vals11: Vec<f64>,
     /// The leading block of the preconditioner matrix, in A11's order.
     pre11: Vec<f64>,
@@ -66,7 +65,6 @@ impl<S: LinearSolver> BorderedSolver<S> {
             pattern_nnz: usize::MAX,
             n0: 0,
             sym11: None,
-            map11: Vec::new(),
             vals11: Vec::new(),
             pre11: Vec::new(),
             a12: Vec::new(),
@@ -94,7 +92,6 @@ impl<S: LinearSolver> BorderedSolver<S> {
         let (cp, ri) = (sym.col_ptr(), sym.row_idx());
         let mut col_ptr = Vec::with_capacity(n0 + 1);
         let mut row_idx = Vec::new();
-        self.map11.clear();
         self.a12.clear();
         self.a21.clear();
         self.a22.clear();
@@ -104,8 +101,11 @@ impl<S: LinearSolver> BorderedSolver<S> {
                 let i = ri[p];
                 match (i < n0, j < n0) {
                     (true, true) => {
+                        // (rows ascend: a column's rows of A11 come first, see copy11)
+                        if p - cp[j] != row_idx.len() - col_ptr[j] {
+                            return Err(StampError::LinearSolver("the rows of a bordered matrix's columns must ascend".into()));
+                        }
                         row_idx.push(i);
-                        self.map11.push(p);
                     }
                     (true, false) => self.a12.push((i, j - n0, p)),
                     (false, true) => self.a21.push((i - n0, j, p)),
@@ -116,11 +116,21 @@ impl<S: LinearSolver> BorderedSolver<S> {
                 col_ptr.push(row_idx.len());
             }
         }
+        self.vals11 = vec![0.0; row_idx.len()];
         self.sym11 = Some(SymbolicSparseColMat::new_checked(n0, n0, col_ptr, None, row_idx));
-        self.vals11 = vec![0.0; self.map11.len()];
         self.n0 = n0;
         self.pattern_nnz = ri.len();
         Ok(())
+    }
+}
+
+/// The values of A11 (column pointers `cp11`) out of the whole matrix's (column pointers `cp`):
+/// column j of A11 is the first cp11[j + 1] - cp11[j] entries of the whole column j (its rows
+/// ascend, and A11's come first), so no map of positions is kept.
+fn copy11(cp11: &[usize], cp: &[usize], whole: &[f64], out: &mut [f64]) {
+    for j in 0..cp11.len() - 1 {
+        let len = cp11[j + 1] - cp11[j];
+        out[cp11[j]..cp11[j + 1]].copy_from_slice(&whole[cp[j]..cp[j] + len]);
     }
 }
 
@@ -143,16 +153,14 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         }
         let (n0, m) = (self.n0, self.border);
         let vals = a.val();
-        for (v, &p) in self.vals11.iter_mut().zip(&self.map11) {
-            *v = vals[p];
-        }
         let sym11 = self.sym11.as_ref().unwrap().as_ref();
+        copy11(sym11.col_ptr(), a.symbolic().col_ptr(), vals, &mut self.vals11);
         let a11 = SparseColMatRef::new(sym11, &self.vals11);
         match p {
             Some(p) if crate::linalg::sparse::same_pattern(p.symbolic(), a.symbolic()) => {
                 let pv = p.val();
-                self.pre11.clear();
-                self.pre11.extend(self.map11.iter().map(|&k| pv[k]));
+                self.pre11.resize(self.vals11.len(), 0.0);
+                copy11(sym11.col_ptr(), a.symbolic().col_ptr(), pv, &mut self.pre11);
                 self.inner.factorize_preconditioned(a11, Some(SparseColMatRef::new(sym11, &self.pre11)))?;
             }
             Some(_) => return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into())),

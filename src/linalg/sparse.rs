@@ -32,11 +32,30 @@ impl SparsePattern {
     /// contact's tangent couples the nodes of two cells that share a node: see
     /// [`crate::contact::ContactFace`]). Element slots are those of the larger pattern.
     pub fn coupled(dofs: &DofMap, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>, couplings: &[Vec<usize>]) -> Result<Self> {
+        Self::build(dofs, num_elements, nodes_per_element, element_nodes, couplings, None)
+    }
+
+    /// The pattern of some of the elements only (`subset[e]`, one flag per element) and of the
+    /// groups of `couplings` that hold a node of theirs: the entries a process of a shared model
+    /// needs (its elements' and the whole rows of its nodes, see [`crate::share`]). The nodes of
+    /// no such element or group have no entries, not even on the diagonal; the other elements'
+    /// slots are left out ([`slot`](Self::slot) is for the subset's elements only). Columns and
+    /// rows are still all the equations.
+    pub fn coupled_subset(dofs: &DofMap, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>, couplings: &[Vec<usize>], subset: &[bool]) -> Result<Self> {
+        if subset.len() != num_elements {
+            return Err(StampError::Problem(format!("a subset of {} flags for {num_elements} elements", subset.len())));
+        }
+        Self::build(dofs, num_elements, nodes_per_element, element_nodes, couplings, Some(subset))
+    }
+
+    fn build(dofs: &DofMap, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>, couplings: &[Vec<usize>], subset: Option<&[bool]>) -> Result<Self> {
         let nn = dofs.num_nodes();
         let dpn = dofs.dofs_per_node();
         let npe = nodes_per_element;
-        // node adjacency (each node is its own neighbour)
-        let mut count = vec![1usize; nn];
+        let taken = |e: usize| subset.is_none_or(|s| s[e]);
+        // node adjacency (each node of the pattern is its own neighbour; without a subset, every
+        // node is of the pattern)
+        let mut count = vec![usize::from(subset.is_none()); nn];
         let mut conn = Vec::with_capacity(num_elements * npe);
         for e in 0..num_elements {
             let nodes = element_nodes(e);
@@ -47,17 +66,24 @@ impl SparsePattern {
                 if a >= nn {
                     return Err(StampError::Mesh(format!("element {e} refers to node {a}, the model has {nn}")));
                 }
-                count[a] += npe - 1;
+                if taken(e) {
+                    count[a] = count[a].max(1) + npe - 1;
+                }
             }
             conn.extend_from_slice(&nodes);
         }
-        let orphan = (0..nn).find(|&i| count[i] == 1);
+        let orphan = (0..nn).find(|&i| count[i] == 1).filter(|_| subset.is_none());
         for g in couplings {
-            for &a in g {
-                if a >= nn {
-                    return Err(StampError::Mesh(format!("a coupling refers to node {a}, the model has {nn}")));
-                }
-                count[a] += g.len() - 1;
+            if let Some(&a) = g.iter().find(|&&a| a >= nn) {
+                return Err(StampError::Mesh(format!("a coupling refers to node {a}, the model has {nn}")));
+            }
+        }
+        // the groups of the pattern: all of them, or those that hold a node of the subset's
+        // elements (their other nodes join the pattern)
+        let groups: Vec<&Vec<usize>> = couplings.iter().filter(|g| subset.is_none() || g.iter().any(|&a| count[a] > 0)).collect();
+        for g in &groups {
+            for &a in g.iter() {
+                count[a] = count[a].max(1) + g.len() - 1;
             }
         }
         if let Some(orphan) = orphan {
@@ -71,11 +97,11 @@ impl SparsePattern {
         }
         let mut adj = vec![0usize; start[nn]];
         let mut fill = start.clone();
-        for i in 0..nn {
+        for i in (0..nn).filter(|&i| count[i] > 0) {
             adj[fill[i]] = i;
             fill[i] += 1;
         }
-        for e in 0..num_elements {
+        for e in (0..num_elements).filter(|&e| taken(e)) {
             let nodes = &conn[e * npe..(e + 1) * npe];
             for &a in nodes {
                 for &b in nodes {
@@ -86,9 +112,9 @@ impl SparsePattern {
                 }
             }
         }
-        for g in couplings {
-            for &a in g {
-                for &b in g {
+        for g in &groups {
+            for &a in g.iter() {
+                for &b in g.iter() {
                     if a != b {
                         adj[fill[a]] = b;
                         fill[a] += 1;
@@ -155,7 +181,7 @@ impl SparsePattern {
         debug_assert_eq!(col_ptr.len(), neq + 1);
         // element block offsets
         let mut block_start = vec![0u32; num_elements * npe * npe];
-        for e in 0..num_elements {
+        for e in (0..num_elements).filter(|&e| taken(e)) {
             let nodes = &conn[e * npe..(e + 1) * npe];
             for (bl, &b) in nodes.iter().enumerate() {
                 let list = &nbr[nbr_start[b]..nbr_start[b + 1]];
@@ -205,6 +231,24 @@ impl SparsePattern {
             col_ptr.push(row_idx.len());
         }
         let symbolic = SymbolicSparseColMat::new_checked(n0 + nb, n0 + nb, col_ptr, None, row_idx);
+        SparsePattern { symbolic, block_start: self.block_start.clone(), rank: self.rank.clone(), nodes_per_element: self.nodes_per_element }
+    }
+
+    /// The leading `n0` x `n0` block of this pattern: [`bordered`](Self::bordered)'s inverse (the
+    /// rows of a column are sorted, so each column's first rows are the block's). Element slots
+    /// are unchanged.
+    pub fn unbordered(&self, n0: usize) -> SparsePattern {
+        let n0 = n0.min(self.size());
+        let (cp, ri) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        let mut col_ptr = Vec::with_capacity(n0 + 1);
+        let mut row_idx = Vec::with_capacity(cp[n0]);
+        col_ptr.push(0);
+        for j in 0..n0 {
+            let col = &ri[cp[j]..cp[j + 1]];
+            row_idx.extend_from_slice(&col[..col.partition_point(|&i| i < n0)]);
+            col_ptr.push(row_idx.len());
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(n0, n0, col_ptr, None, row_idx);
         SparsePattern { symbolic, block_start: self.block_start.clone(), rank: self.rank.clone(), nodes_per_element: self.nodes_per_element }
     }
 
@@ -292,4 +336,86 @@ pub fn pair_transposed(col_ptr: &[usize], row_idx: &[usize], mut pair: impl FnMu
         }
     }
     (0..n).all(|i| seen[i] == col_ptr[i + 1] - col_ptr[i])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::QuadMesh;
+    use std::collections::BTreeSet;
+
+    /// A 4 x 3 mesh, 3 dofs per node, the left edge's first dof prescribed.
+    fn setup() -> (QuadMesh, DofMap) {
+        let mesh = QuadMesh::rectangle(0.0, 4.0, 0.0, 3.0, 4, 3).unwrap();
+        let mut dofs = DofMap::new(mesh.num_nodes(), 3).unwrap();
+        dofs.fix(mesh.group_nodes("left").unwrap(), &[0]).unwrap();
+        (mesh, dofs)
+    }
+
+    fn entries(p: &SparsePattern) -> BTreeSet<(usize, usize)> {
+        let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+        (0..p.size()).flat_map(|j| ri[cp[j]..cp[j + 1]].iter().map(move |&i| (i, j))).collect()
+    }
+
+    /// The equations of the free dofs of `nodes`.
+    fn equations(dofs: &DofMap, nodes: &[usize]) -> Vec<usize> {
+        nodes.iter().flat_map(|&n| (0..3).filter_map(move |c| dofs.equation(3 * n + c))).collect()
+    }
+
+    /// A subset's pattern holds exactly the pairs of its elements' equations (and a group's that
+    /// touches them), and each of its elements' slots is its (row, column) entry there.
+    #[test]
+    fn a_subset_pattern_holds_its_elements_entries_and_their_slots() {
+        let (mesh, dofs) = setup();
+        let ne = mesh.num_cells();
+        let nodes = |e: usize| mesh.cells[e].to_vec();
+        let subset: Vec<bool> = (0..ne).map(|e| e % 4 == 1 || e == 6).collect();
+        // a group that touches element 1's nodes, and one that does not
+        let touching = vec![mesh.cells[1][0], mesh.cells[10][2]];
+        let far = vec![mesh.cells[11][2], mesh.cells[8][0]];
+        assert!(!subset[8] && !subset[10] && !subset[11] && !mesh.cells.iter().zip(&subset).any(|(c, s)| *s && (c.contains(&far[0]) || c.contains(&far[1]))));
+        let p = SparsePattern::coupled_subset(&dofs, ne, 4, nodes, &[touching.clone(), far], &subset).unwrap();
+        let mut want = BTreeSet::new();
+        for group in (0..ne).filter(|&e| subset[e]).map(nodes).chain([touching]) {
+            let eqs = equations(&dofs, &group);
+            want.extend(eqs.iter().flat_map(|&i| eqs.iter().map(move |&j| (i, j))));
+        }
+        assert_eq!(entries(&p), want);
+        assert_eq!(p.size(), dofs.num_equations());
+        let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+        for e in (0..ne).filter(|&e| subset[e]) {
+            let en = nodes(e);
+            for (b, &nb) in en.iter().enumerate() {
+                for cb in 0..3 {
+                    let Some(col) = dofs.equation(3 * nb + cb) else { continue };
+                    for (a, &na) in en.iter().enumerate() {
+                        for ca in 0..3 {
+                            let row_dof = 3 * na + ca;
+                            let Some(row) = dofs.equation(row_dof) else { continue };
+                            let slot = p.slot(e, a, b, row_dof, col);
+                            assert!(slot >= cp[col] && slot < cp[col + 1] && ri[slot] == row, "element {e}: ({row}, {col})");
+                        }
+                    }
+                }
+            }
+        }
+        // every element: the whole pattern
+        let all = SparsePattern::coupled_subset(&dofs, ne, 4, nodes, &[], &vec![true; ne]).unwrap();
+        assert_eq!(entries(&all), entries(&SparsePattern::new(&dofs, ne, 4, nodes).unwrap()));
+        assert!(SparsePattern::coupled_subset(&dofs, ne, 4, nodes, &[], &[true]).is_err());
+    }
+
+    /// `unbordered` undoes `bordered`, element slots included.
+    #[test]
+    fn unbordered_undoes_bordered() {
+        let (mesh, dofs) = setup();
+        let ne = mesh.num_cells();
+        let p = SparsePattern::new(&dofs, ne, 4, |e| mesh.cells[e].to_vec()).unwrap();
+        let b = p.bordered(&dofs, &[vec![3, 4, 5, 30, 31], vec![12, 13]]);
+        assert_eq!(b.size(), p.size() + 2);
+        let u = b.unbordered(p.size());
+        assert_eq!(entries(&u), entries(&p));
+        assert_eq!(u.symbolic().col_ptr(), p.symbolic().col_ptr());
+        assert_eq!(u.slot(5, 1, 2, 3 * mesh.cells[5][1], dofs.equation(3 * mesh.cells[5][2]).unwrap()), p.slot(5, 1, 2, 3 * mesh.cells[5][1], dofs.equation(3 * mesh.cells[5][2]).unwrap()));
+    }
 }
