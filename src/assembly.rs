@@ -319,13 +319,17 @@ impl Assembler {
     /// The error of element `refused`, which refused the state `u`: the reason from the element
     /// itself ([`StampError::Inadmissible`]).
     pub fn refusal<E: Element>(element: &E, dofs: &DofMap, u: &[f64], refused: usize) -> StampError {
+        StampError::Inadmissible { element: refused, reason: Self::refusal_reason(element, dofs, u, refused) }
+    }
+
+    /// Why element `refused` refuses the state `u` (evaluated again to ask it).
+    pub fn refusal_reason<E: Element>(element: &E, dofs: &DofMap, u: &[f64], refused: usize) -> String {
         let dpn = dofs.dofs_per_node();
         let nloc = dpn * element.nodes_per_element();
         let mut local = LocalSystem::new(nloc);
         let ue: Vec<f64> = element.element_nodes(refused).iter().flat_map(|&n| (0..dpn).map(move |c| u[n * dpn + c])).collect();
         element.evaluate(refused, &ue, &mut element.new_workspace(), &mut local, false);
-        let reason = local.inadmissible.unwrap_or_else(|| "refused (no reason given)".into());
-        StampError::Inadmissible { element: refused, reason }
+        local.inadmissible.unwrap_or_else(|| "refused (no reason given)".into())
     }
 }
 

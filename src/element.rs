@@ -69,6 +69,11 @@ pub trait Element: Sync {
     fn has_preconditioner(&self) -> bool {
         false
     }
+    /// Keep what is stored per element (its reference geometry, say) only for the elements
+    /// flagged in `keep` (one flag per element): for a process of a shared model that evaluates
+    /// those alone (see [`crate::share`]), so that it does not hold the whole model's element
+    /// data. The others must not be evaluated afterwards. Default: nothing is dropped.
+    fn retain_elements(&mut self, _keep: &[bool]) {}
     /// A fresh workspace.
     fn new_workspace(&self) -> Self::Workspace;
     /// Evaluate element `e` at the local dof values `u`: fill `out.residual` (internal force), the

@@ -360,6 +360,12 @@ impl<E: Element> NonlinearProblem for Model<E> {
             }
         }
         if refused != usize::MAX {
+            if let Some(share) = &self.share {
+                // the element's own process says why: the others may not hold its data
+                let mine = share.elements.binary_search(&refused).is_ok().then(|| Assembler::refusal_reason(&self.element, &self.dofs, u, refused));
+                let reason = share.reduce.text(mine.as_deref())?;
+                return Err(StampError::Inadmissible { element: refused, reason });
+            }
             return Err(Assembler::refusal(&self.element, &self.dofs, u, refused));
         }
         self.energy = energy;

@@ -2,7 +2,8 @@
 //! distributed run, with no knowledge of how the processes talk (MPI lives in the caller, behind
 //! [`Reduce`]).
 //!
-//! Every process holds the whole model and the same iterate. With a [`Share`] set
+//! Every process holds the whole model (less, if it likes, the data of the elements it does not
+//! evaluate: [`crate::element::Element::retain_elements`]) and the same iterate. With a [`Share`] set
 //! ([`crate::model::Model::set_share`]) a process evaluates only its own elements; their internal
 //! forces and energy are summed over the processes ([`Reduce::sum`]) before anything reads them, so
 //! the residual, the reactions, the energy and every test on them are the whole model's on every
@@ -26,6 +27,26 @@ pub trait Reduce: Send + Sync {
     fn sum(&self, v: &mut [f64]) -> Result<()>;
     /// The smallest of each entry of `v` over the processes, in place.
     fn min(&self, v: &mut [u64]) -> Result<()>;
+    /// The text of the one process that passes some (the others pass None), on every process:
+    /// the reason an element refused the state, which only its own process can say (the others
+    /// may not hold its data). Built on [`min`](Self::min): its bytes in words, the others' all
+    /// ones.
+    fn text(&self, mine: Option<&str>) -> Result<String> {
+        let mut len = [u64::MAX - mine.map_or(0, |t| t.len() as u64)];
+        self.min(&mut len)?;
+        let n = usize::try_from(u64::MAX - len[0]).unwrap_or(0);
+        let mut words = vec![u64::MAX; n.div_ceil(8)];
+        if let Some(t) = mine {
+            for (w, chunk) in words.iter_mut().zip(t.as_bytes().chunks(8)) {
+                let mut b = [0u8; 8];
+                b[..chunk.len()].copy_from_slice(chunk);
+                *w = u64::from_le_bytes(b);
+            }
+        }
+        self.min(&mut words)?;
+        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).take(n).collect();
+        Ok(String::from_utf8_lossy(&bytes).into_owned())
+    }
 }
 
 /// What one process evaluates.

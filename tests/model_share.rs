@@ -4,12 +4,14 @@
 //! contact state are the whole model's, the shares' tangents and preconditioners add up to the
 //! whole model's in the nodal block, and the punch's row and column are whole in every share.
 //! Each share's pattern is its own, smaller than the whole's, and holds the whole rows of the
-//! nodes it owns. An element that refuses the state on one share gives every share the same error.
+//! nodes it owns. Each share keeps its own elements' data only; an element that refuses the state
+//! on one share gives every share the same error, its reason told by that share.
 
 mod common;
 use common::*;
 use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive};
 use stamp::dofs::DofMap;
+use stamp::element::Element;
 use stamp::error::Result;
 use stamp::linalg::partition::{node_owners, partition_elements};
 use stamp::mesh::QuadMesh;
@@ -119,9 +121,13 @@ fn shared(mesh: &QuadMesh, u: &[f64]) -> (Vec<Outcome>, Vec<u32>) {
                     owned_nodes: owner.iter().map(|&o| o == k).collect(),
                     reduce: reduce.clone(),
                 };
+                let own: Vec<bool> = part.iter().map(|&q| q == k).collect();
                 s.spawn(move || {
                     let mut m = model(mesh);
                     m.set_share(Some(share)).unwrap();
+                    // each share holds its own elements' data only: an element of another
+                    // share that refuses the state is told of by that share
+                    m.element.retain_elements(&own);
                     evaluate(&mut m, u)
                 })
             })

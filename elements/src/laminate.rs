@@ -19,6 +19,7 @@
 //! 12 N unknowns to the element's 12 M. The ply's law is turned into the element's local frame
 //! (its t1 along dX/dxi1 at the centre) by the angle between t1 and the ply's fibres.
 
+use crate::geometries::Geometries;
 use crate::geometry::ElementGeometry;
 use crate::multi_surface::{compute_samples, evaluate_levels, inside_out, resultants_of, strain, workspace, Law, Level, MultiSurfaceWorkspace, Resultants};
 use crate::orthotropic::{rotate, PlyMaterial, Stiffness};
@@ -147,7 +148,7 @@ struct PlyPart<const N: usize, const D: usize> {
 /// (node, surface) pairs and dofs.
 pub struct LaminatePlate<const N: usize, const P: usize, const D: usize> {
     cells: Vec<[usize; 4]>,
-    geometry: Vec<ElementGeometry>,
+    geometry: Geometries,
     /// The angle of each element's local t1 from x1.
     frame_angle: Vec<f64>,
     plies: Vec<PlyPart<N, D>>,
@@ -206,7 +207,7 @@ impl<const N: usize, const P: usize, const D: usize> LaminatePlate<N, P, D> {
                 PlyPart { levels, c: rotate(&ply.material.stiffness(), ply.angle.to_radians()), isotropic, dofs }
             })
             .collect();
-        Ok(LaminatePlate { cells: mesh.cells.clone(), geometry, frame_angle, plies, surfaces: m, laminate, kinematics })
+        Ok(LaminatePlate { cells: mesh.cells.clone(), geometry: Geometries::new(geometry), frame_angle, plies, surfaces: m, laminate, kinematics })
     }
 
     pub fn laminate(&self) -> &Laminate {
@@ -285,6 +286,9 @@ impl<const N: usize, const P: usize, const D: usize> LaminatePlate<N, P, D> {
 impl<const N: usize, const P: usize, const D: usize> Element for LaminatePlate<N, P, D> {
     type Workspace = LaminateWorkspace<P, D>;
 
+    fn retain_elements(&mut self, keep: &[bool]) {
+        self.geometry.retain(keep);
+    }
     fn dofs_per_node(&self) -> usize {
         3 * self.surfaces
     }

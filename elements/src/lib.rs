@@ -7,6 +7,7 @@
 //! It plugs into the stamp framework as an [`stamp::element::Element`].
 
 pub mod follower;
+pub mod geometries;
 pub mod geometry;
 pub mod material;
 pub mod plate;

@@ -42,6 +42,7 @@
 //! rigid motions are untouched, and the variation it scales vanishes as the mesh is refined.
 //! Measured variants: docs/verification.md.
 
+use crate::geometries::Geometries;
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section};
 use crate::orthotropic::Stiffness;
@@ -242,7 +243,7 @@ impl<const P: usize, const D: usize> MultiSurfaceWorkspace<P, D> {
 /// component i.
 pub struct MultiSurfacePlate<const N: usize, const P: usize, const D: usize> {
     cells: Vec<[usize; 4]>,
-    geometry: Vec<ElementGeometry>,
+    geometry: Geometries,
     levels: Vec<Level<N>>,
     laws: Vec<Law>,
     section: Section,
@@ -274,7 +275,7 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
             laws.push(Law::Isotropic { lambda: layer.material.lame_lambda(), mu: layer.material.shear_modulus() });
             levels.extend(Level::<N>::of_layer(layer.bottom, layer.top, mid, h, &zs, k));
         }
-        Ok(MultiSurfacePlate { cells: mesh.cells.clone(), geometry, levels, laws, section, kinematics })
+        Ok(MultiSurfacePlate { cells: mesh.cells.clone(), geometry: Geometries::new(geometry), levels, laws, section, kinematics })
     }
 
     pub fn section(&self) -> &Section {
@@ -612,6 +613,9 @@ pub(crate) fn inside_out(volume_ratio: f64) -> String {
 impl<const N: usize, const P: usize, const D: usize> Element for MultiSurfacePlate<N, P, D> {
     type Workspace = MultiSurfaceWorkspace<P, D>;
 
+    fn retain_elements(&mut self, keep: &[bool]) {
+        self.geometry.retain(keep);
+    }
     fn dofs_per_node(&self) -> usize {
         Self::DOFS_PER_NODE
     }

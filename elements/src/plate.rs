@@ -9,6 +9,7 @@
 //! dropped from the material stiffness), the linear solver's preconditioner
 //! ([`Element::has_preconditioner`]).
 
+use crate::geometries::Geometries;
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section, NSTRAIN};
 use crate::strain::{add_geometric_stiffness, axpy, triple, Affine, Sample, NDOF, NPAIR};
@@ -120,7 +121,7 @@ pub struct GaussState {
 /// The plate elements of a mesh.
 pub struct PlateElements {
     cells: Vec<[usize; 4]>,
-    geometry: Vec<ElementGeometry>,
+    geometry: Geometries,
     d: [[f64; NSTRAIN]; NSTRAIN],
     /// The nonzero entries (column, value) of every row of D.
     d_rows: [([(usize, f64); NSTRAIN], usize); NSTRAIN],
@@ -153,7 +154,7 @@ impl PlateElements {
                 *n += 1;
             }
         }
-        Ok(PlateElements { cells: mesh.cells.clone(), geometry, d, d_rows, section, kinematics, coupled })
+        Ok(PlateElements { cells: mesh.cells.clone(), geometry: Geometries::new(geometry), d, d_rows, section, kinematics, coupled })
     }
 
     pub fn section(&self) -> &Section {
@@ -300,6 +301,9 @@ impl Element for PlateElements {
     /// geometric and contact stiffnesses are symmetric and kept whole. Measured against the
     /// symmetric part of the tangent as GMRES's preconditioner, on the sphere problem: about half
     /// the GMRES iterations (README "Speed").
+    fn retain_elements(&mut self, keep: &[bool]) {
+        self.geometry.retain(keep);
+    }
     fn has_preconditioner(&self) -> bool {
         self.coupled
     }

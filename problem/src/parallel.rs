@@ -176,7 +176,13 @@ pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, lin
             owned_nodes: owner.iter().map(|&o| o == r).collect(),
             reduce: std::sync::Arc::new(MpiReduce(petsc)),
         };
+        let own: Vec<bool> = part.iter().map(|&q| q == r).collect();
         model.set_share(Some(share))?;
+        // the ranks that write no outputs evaluate only their own elements: they drop the others'
+        // geometry (rank 0 keeps it: the outputs are every element's)
+        if !writes_outputs() {
+            model.element.retain_elements(&own);
+        }
         linear.set_partition(Some(equation_owner));
         Ok(())
     }

@@ -263,6 +263,9 @@ impl Element for Plate {
     fn has_preconditioner(&self) -> bool {
         each!(self, p => p.has_preconditioner())
     }
+    fn retain_elements(&mut self, keep: &[bool]) {
+        each!(self, p => p.retain_elements(keep))
+    }
     fn new_workspace(&self) -> PlateWs {
         match self {
             Plate::TwoSurface(p) => PlateWs::TwoSurface(p.new_workspace()),
