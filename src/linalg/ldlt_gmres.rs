@@ -107,6 +107,9 @@ pub const ND_MIN_UNKNOWNS: usize = 100_000;
 const ACCEPT: f64 = 1e-14;
 /// Backward error above which, after refinement, the matrix goes to the LU.
 const FALLBACK: f64 = 1e-10;
+/// Bytes the sparse LU is taken to need per entry of the LDL^T factor of the same pattern: its
+/// factors hold about ten times the entries (module doc), each a value and a row index.
+const LU_BYTES_PER_LDLT_ENTRY: usize = 10 * 16;
 
 /// Fill-reducing ordering of the LDL^T factor.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -360,6 +363,12 @@ impl LdltGmres {
 
     fn factorize_lu(&mut self) -> Result<()> {
         let n = self.col_ptr.len() - 1;
+        // the LU's factors are about ten times the LDL^T's: on a large plate more than the machine
+        // has (at n = 400 in `stamp bench`, 50 GB against a 2.5 GB LDL^T factor), and a process
+        // that outgrows it is killed with nothing said. Refused instead: Newton cuts the step back.
+        if let Some(why) = lu_refusal(n, self.factor_len(), available_memory()) {
+            return Err(StampError::LinearSolver(why));
+        }
         if let Some(tr) = &self.transpose {
             // A's columns from its rows: a_ij sits at the transposed position of a_ji
             self.values = tr.iter().map(|&k| self.row_values[k]).collect();
@@ -489,6 +498,27 @@ impl LdltGmres {
         }
         Ok(())
     }
+}
+
+/// Why the sparse LU of a matrix of `n` unknowns whose LDL^T factor holds `ldlt_entries` would
+/// not fit in `available` bytes (None: it fits, or the memory is not known).
+fn lu_refusal(n: usize, ldlt_entries: usize, available: Option<usize>) -> Option<String> {
+    let need = ldlt_entries.saturating_mul(LU_BYTES_PER_LDLT_ENTRY);
+    let available = available.filter(|&a| need > a)?;
+    let gib = |b: usize| b as f64 / (1u64 << 30) as f64;
+    Some(format!(
+        "the LDL^T-preconditioned GMRES did not solve this matrix of {n} unknowns, and the sparse LU that would take over needs about {:.1} GiB, more than the {:.1} GiB available",
+        gib(need),
+        gib(available)
+    ))
+}
+
+/// The memory the system can still give a process (Linux: `MemAvailable` of /proc/meminfo), in
+/// bytes; None where that cannot be read.
+fn available_memory() -> Option<usize> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kib: usize = info.lines().find_map(|l| l.strip_prefix("MemAvailable:"))?.trim().trim_end_matches("kB").trim().parse().ok()?;
+    kib.checked_mul(1024)
 }
 
 /// The parallelism of faer's numeric LDL^T, chosen by measurement, not assumed. With a parallel setting, the first numeric
@@ -841,12 +871,18 @@ impl LinearSolver for LdltGmres {
                     b.copy_from_slice(&self.rhs);
                     return self.solve_in_place_to(b, rtol);
                 }
+                if !report.converged && std::env::var_os("STAMP_DEBUG").is_some() {
+                    eprintln!("  GMRES: backward error {:.2e} after {} iterations (asked {rtol:.1e})", report.backward_error, report.iterations);
+                }
                 report.converged
             }
         };
         self.timings.solve += t.elapsed().as_secs_f64();
         self.timings.solves += 1;
         if !ok || b.iter().any(|x| !x.is_finite()) {
+            if std::env::var_os("STAMP_DEBUG").is_some() {
+                eprintln!("  linear solve not accurate enough ({:?}): the LU takes over", self.mode);
+            }
             // not accurate enough on this matrix: the LU of the same values
             self.factorize_lu()?;
             b.copy_from_slice(&self.rhs);
@@ -923,6 +959,22 @@ mod tests {
         let scale = exact.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let err = b.iter().zip(&exact).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale;
         assert!(err < 1e-9, "error {err:e}, {:?}", solver.stats());
+    }
+
+    /// The LU is refused where ten times the LDL^T's entries exceed the memory available (the
+    /// factor of n = 400 in `stamp bench`, 312 million entries, on a 24 GiB machine), allowed
+    /// where they fit or the memory is not known; the machine's memory is read.
+    #[test]
+    fn lu_refused_where_it_cannot_fit() {
+        let gib = 1usize << 30;
+        let why = lu_refusal(961_600, 312_000_000, Some(20 * gib)).expect("refused");
+        assert!(why.contains("961600 unknowns") && why.contains("46.5 GiB") && why.contains("20.0 GiB available"), "{why}");
+        assert_eq!(lu_refusal(60_400, 6_000_000, Some(20 * gib)), None);
+        assert_eq!(lu_refusal(961_600, 312_000_000, None), None);
+        if cfg!(target_os = "linux") {
+            let a = available_memory().expect("MemAvailable");
+            assert!(a > (1 << 20), "{a}");
+        }
     }
 
     #[test]
