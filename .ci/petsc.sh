@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # The PETSc back end (cargo feature `petsc`): installs PETSc and MPI, runs stamp-petsc's tests
-# (distributed solves on 1, 2 and 4 ranks), then the shipped examples with `mpirun -n P stamp run`
-# against the default (faer) run: every history.csv column within 1e-8 of its scale
-# (.ci/compare_history.py), all examples on 1 rank, the quicker ones on 2 and 4; and failing ranks
-# (a rank that fails alone, a Newton failure, a bad problem file): every rank ends, one message.
-# About 3-4 minutes on the 2-core machine after the default build (see the timing it prints).
+# (distributed solves on 1, 2 and 4 ranks), then every shipped example with `mpirun -n P stamp run`
+# on 1, 2 and 4 ranks (the laminate on a coarser mesh) against the default (faer) run: every
+# history.csv column within 1e-8 of its scale (.ci/compare_history.py); and failing ranks (a rank
+# that fails alone, a Newton failure, a bad problem file): every rank ends, one message.
+# About 2 minutes on the 2-core machine after the builds (see the timing it prints).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$SECONDS
@@ -33,22 +33,26 @@ stamp=target/release/stamp
 
 # sphere-clamped is compared at 1e-5: its first step converges with |R| at 5e-9 of the force
 # scale, and the peak pressure there differs by 1.2e-6 between the faer and the PETSc iterates
-quick="sphere-ss sphere-ss-displacement paper-r100 stl-die squeeze sphere-clamped ellipsoid-expression sphere-slide cantilever-roll"
 for f in meshes/*.toml; do
   name=$(basename "$f" .toml)
-  # the laminate (13 surfaces, 40 x 40: 34 s with faer, minutes on PETSc) would take a third of
-  # this script's time: its solver path is the other examples'
-  [ "$name" = laminate-sphere ] && continue
   # both runs converge Newton to 1e-12 of the force scale (the default 1e-10 left the force of
   # sphere-ss-displacement 1.01e-8 apart on 4 ranks, 3e-9 at 1e-12); the copy stays beside the
   # original, whose relative paths it keeps
   case_file="meshes/.ci-petsc-$name.toml"
   sed 's/^\[solver\]/[solver]\nrel_tol = 1e-12/' "$f" >"$case_file"
+  # the laminate (13 surfaces: minutes on PETSc at its 40 x 40) runs on 12 x 12
+  [ "$name" = laminate-sphere ] && sed -i 's/n = \[40, 40\]/n = [12, 12]/' "$case_file"
   "$work/stamp-faer" run "$case_file" --out "$work/faer-$name" -q 2>/dev/null || { bad "$name: the faer run failed"; continue; }
   tol=1e-8
   [ "$name" = sphere-clamped ] && tol=1e-5
+  # the plates of four and thirteen surfaces (stiff through the thickness) end 1e-8 to 2e-8 apart
+  # from faer's run in one column: the laminate's peak pressure in step 4 by 1.96e-8 on 1, 2 and
+  # 4 ranks alike and at any Newton or penetration tolerance (steps 1-3 agree to every digit:
+  # two converged states, not an unconverged one); sphere-ss-4surfaces's force by 4e-9 to
+  # 1.2e-8, varying from run to run on 2 and 4 ranks (MUMPS's parallel factorisation does not
+  # sum in a fixed order)
+  case $name in laminate-sphere) tol=5e-8 ;; sphere-ss-4surfaces) tol=3e-8 ;; esac
   for ranks in 1 2 4; do
-    if [ "$ranks" != 1 ] && ! [[ " $quick " == *" $name "* ]]; then continue; fi
     out="$work/p$ranks-$name"
     if ! timeout 300 "${mpirun[@]}" -n "$ranks" "$stamp" run "$case_file" --out "$out" -q 2>"$out.err"; then
       bad "$name on $ranks ranks: $(tail -3 "$out.err")"
