@@ -57,6 +57,23 @@ macro_rules! each {
     };
 }
 
+/// Dispatch `$body` on the plate's variant and its workspace's, bound to `$p` and `$w` (a
+/// workspace is made by its own plate: see `new_workspace`).
+macro_rules! each_with_workspace {
+    ($plate:expr, $ws:expr, ($p:ident, $w:ident) => $body:expr) => {
+        match ($plate, $ws) {
+            (Plate::TwoSurface($p), PlateWs::TwoSurface($w)) => $body,
+            (Plate::ThreeSurface($p), PlateWs::ThreeSurface($w)) => $body,
+            (Plate::FourSurface($p), PlateWs::FourSurface($w)) => $body,
+            (Plate::FiveSurface($p), PlateWs::FiveSurface($w)) => $body,
+            (Plate::ThreeSurfaceLayers($p), PlateWs::ThreeSurfaceLayers($w)) => $body,
+            (Plate::FourSurfaceLayers($p), PlateWs::FourSurfaceLayers($w)) => $body,
+            (Plate::FiveSurfaceLayers($p), PlateWs::FiveSurfaceLayers($w)) => $body,
+            _ => unreachable!("a workspace is made by its own plate"),
+        }
+    };
+}
+
 impl Plate {
     /// The plate of `surfaces` surfaces (2 to 5) on `mesh`.
     pub fn new(surfaces: usize, mesh: &QuadMesh, section: Section, kinematics: Kinematics) -> Result<Plate> {
@@ -278,28 +295,10 @@ impl Element for Plate {
         }
     }
     fn evaluate(&self, e: usize, u: &[f64], ws: &mut PlateWs, out: &mut LocalSystem, with_tangent: bool) {
-        match (self, ws) {
-            (Plate::TwoSurface(p), PlateWs::TwoSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
-            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
-            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
-            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.evaluate(e, u, w, out, with_tangent),
-            (Plate::ThreeSurfaceLayers(p), PlateWs::ThreeSurfaceLayers(w)) => p.evaluate(e, u, w, out, with_tangent),
-            (Plate::FourSurfaceLayers(p), PlateWs::FourSurfaceLayers(w)) => p.evaluate(e, u, w, out, with_tangent),
-            (Plate::FiveSurfaceLayers(p), PlateWs::FiveSurfaceLayers(w)) => p.evaluate(e, u, w, out, with_tangent),
-            _ => unreachable!("a workspace is made by its own plate"),
-        }
+        each_with_workspace!(self, ws, (p, w) => p.evaluate(e, u, w, out, with_tangent))
     }
     fn evaluate_about(&self, e: usize, u: &[f64], reference: &[f64], ws: &mut PlateWs, out: &mut LocalSystem, with_tangent: bool) {
-        match (self, ws) {
-            (Plate::TwoSurface(p), PlateWs::TwoSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
-            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
-            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
-            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
-            (Plate::ThreeSurfaceLayers(p), PlateWs::ThreeSurfaceLayers(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
-            (Plate::FourSurfaceLayers(p), PlateWs::FourSurfaceLayers(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
-            (Plate::FiveSurfaceLayers(p), PlateWs::FiveSurfaceLayers(w)) => p.evaluate_about(e, u, reference, w, out, with_tangent),
-            _ => unreachable!("a workspace is made by its own plate"),
-        }
+        each_with_workspace!(self, ws, (p, w) => p.evaluate_about(e, u, reference, w, out, with_tangent))
     }
 }
 
