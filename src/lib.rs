@@ -16,6 +16,7 @@ pub use error::{quote, show_path, short_path, Result, StampError};
 pub mod dofs;
 pub mod element;
 pub mod linalg;
+pub mod memory;
 pub mod assembly;
 pub mod contact;
 pub mod follower;

@@ -9,6 +9,8 @@
 //! (`stamp bench --one n`, 2026-11-24): n = 50 peaks at 0.077 GiB (estimate 0.13), n = 100 at
 //! 0.32 GiB (estimate 0.37).
 
+use stamp::memory::{MemoryLimit, ADDRESS_SPACE_OVERHEAD};
+
 /// Unknowns per node of a plate of `surfaces` surfaces (the problem file's `[plate] surfaces`):
 /// three per surface.
 pub fn dofs_per_node(surfaces: impl Into<usize>) -> u64 {
@@ -29,12 +31,6 @@ pub fn estimate_bytes(nodes: u64, dofs_per_node: u64) -> f64 {
     BASE_BYTES + BYTES_PER_UNKNOWN_LOG * unknowns * unknowns.max(2.0).log2()
 }
 
-/// Address space a run takes beyond its data: the program, the threads' stacks and the
-/// allocator's per-thread heaps, which are reserved whether used or not. Measured (VmPeak against
-/// VmHWM, `stamp run`, 2026-11-25, 2 threads): 210 MiB for a 14 MiB run, 300 and 370 MiB for the
-/// sphere-displacement plate at n = 100 and 200; below that `ulimit -v` aborts even small runs.
-pub const ADDRESS_SPACE_OVERHEAD: f64 = 512.0 * 1024.0 * 1024.0;
-
 /// Bytes of memory per facet of an STL die, besides the file's own bytes (read whole): the facet
 /// soup, the welded vertices and their normals, the R-tree. Measured: a binary STL of 1 598 000
 /// facets (80 MB) peaks at 610 MB in `stamp check` (2026-11-25), 330 bytes a facet beyond the file.
@@ -43,43 +39,20 @@ pub const BYTES_PER_STL_FACET: f64 = 360.0;
 /// `vertex` lines, `endloop`, `endfacet`, with the shortest numbers).
 const MIN_ASCII_FACET_BYTES: f64 = 90.0;
 
-/// The memory this process may use, in bytes, and what limits it: the smaller of MemAvailable of
-/// /proc/meminfo (else MemTotal) and the address-space limit (`ulimit -v`, RLIMIT_AS) less
-/// [`ADDRESS_SPACE_OVERHEAD`]; None when neither is known (no check).
+/// The memory this process may use, in bytes ([`stamp::memory::available_bytes`]); None when it
+/// is not known (no check).
 pub fn available_bytes() -> Option<f64> {
-    limit().map(|(bytes, _)| bytes)
+    stamp::memory::available_bytes()
 }
 
 /// [`available_bytes`] with the words for what limits it.
 fn limit() -> Option<(f64, String)> {
-    let memory = meminfo().map(|b| (b, "available".to_string()));
-    let address = address_space_limit().map(|l| {
-        let usable = (l - ADDRESS_SPACE_OVERHEAD).max(0.0);
-        (usable, format!("usable under ulimit -v ({:.2} GiB less {:.2} GiB for stacks and heaps)", l / GIB, ADDRESS_SPACE_OVERHEAD / GIB))
-    });
-    match (memory, address) {
-        (Some(m), Some(a)) => Some(if a.0 < m.0 { a } else { m }),
-        (m, a) => m.or(a),
-    }
-}
-
-/// MemAvailable of /proc/meminfo, else MemTotal.
-fn meminfo() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let field = |name: &str| -> Option<f64> {
-        let line = text.lines().find(|l| l.starts_with(name))?;
-        let kib: f64 = line[name.len()..].trim().trim_end_matches("kB").trim().parse().ok()?;
-        Some(kib * 1024.0)
+    let (bytes, why) = stamp::memory::memory_limit()?;
+    let words = match why {
+        MemoryLimit::Available => "available".to_string(),
+        MemoryLimit::AddressSpace { limit } => format!("usable under ulimit -v ({:.2} GiB less {:.2} GiB for stacks and heaps)", limit / GIB, ADDRESS_SPACE_OVERHEAD / GIB),
     };
-    field("MemAvailable:").or_else(|| field("MemTotal:"))
-}
-
-/// The soft address-space limit of this process (RLIMIT_AS) in bytes; None when unlimited.
-fn address_space_limit() -> Option<f64> {
-    let mut r = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
-    // SAFETY: getrlimit writes the struct it is given
-    let rc = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut r) };
-    (rc == 0 && r.rlim_cur != libc::RLIM_INFINITY).then_some(r.rlim_cur as f64)
+    Some((bytes, words))
 }
 
 /// Estimated memory of an STL die read from `path`: the file's bytes and [`BYTES_PER_STL_FACET`]
