@@ -18,4 +18,11 @@ pub trait DeformationDependentLoad: Send + Sync {
     fn name(&self) -> &str;
     /// Add F(u) to `force` and dF/du to `tangent`.
     fn add_force_and_stiffness(&self, u: &[f64], force: &mut [f64], tangent: Option<&mut dyn FnMut(usize, usize, f64)>);
+    /// In a distributed run (see [`crate::share`]), evaluate from now on only the pieces (cells,
+    /// nodes) that touch a node of `own` (`own[n]`: this process owns node n); None: every piece.
+    /// The caller keeps only the forces and tangent rows of the own nodes, so a load that
+    /// ignores this (the default) is still right, only slower.
+    fn share_nodes(&mut self, own: Option<&[bool]>) {
+        let _ = own;
+    }
 }

@@ -88,6 +88,12 @@ pub struct Model<E: Element> {
     /// ([`Element::evaluate_about`]: the mixed-integration-point Newton iteration); false (the
     /// default): every tangent is the exact derivative of the residual at its iterate.
     pub mixed_tangent: bool,
+    /// With a share: this process's contact forces at the last evaluation (over all dofs, the
+    /// force-driven punches' too), kept apart from the internal forces until they are summed.
+    contact_force: Vec<f64>,
+    /// With a share: a failed reduction in a step that cannot return it (an active-set update, a
+    /// checkpoint), returned by the next evaluation.
+    pending: Option<StampError>,
 }
 
 impl<E: Element> Model<E> {
@@ -133,6 +139,8 @@ impl<E: Element> Model<E> {
             last_u: Vec::new(),
             converged_u: Vec::new(),
             mixed_tangent: false,
+            contact_force: Vec::new(),
+            pending: None,
         })
     }
 
@@ -155,6 +163,7 @@ impl<E: Element> Model<E> {
     /// Add a displacement-dependent load (at load factor 1).
     pub fn add_follower_load(&mut self, load: Box<dyn DeformationDependentLoad>) {
         self.follower_loads.push(load);
+        self.share_loads();
     }
 
     /// The displacement-dependent loads' force over all nodal dofs at the last evaluation, at its
@@ -170,7 +179,20 @@ impl<E: Element> Model<E> {
     /// `num_equations` count the punches at once.
     pub fn add_contact(&mut self, pair: ContactPair) {
         self.contacts.push(pair);
+        self.share_loads();
         self.sync_drives();
+    }
+
+    /// Give the punches and the displacement-dependent loads this process's share (see
+    /// [`crate::share`]): each evaluates the points and pieces at its own nodes.
+    fn share_loads(&mut self) {
+        let own = self.share.as_ref().map(|s| (s.owned_nodes.as_slice(), s.reduce.clone(), s.leader));
+        for c in self.contacts.iter_mut() {
+            c.set_share(own.clone());
+        }
+        for l in self.follower_loads.iter_mut() {
+            l.share_nodes(own.as_ref().map(|o| o.0));
+        }
     }
 
     /// Number of force-driven punches (extra unknowns).
@@ -278,6 +300,7 @@ impl<E: Element> Model<E> {
             taken
         });
         self.share = share;
+        self.share_loads();
         self.rebuild_pattern();
         self.sync_drives();
         Ok(())
@@ -294,26 +317,70 @@ impl<E: Element> Model<E> {
     /// punch whose constraints at the last evaluation are violated beyond
     /// [`augmented_tolerance`](Self::augmented_tolerance): a penetration above it, or an active
     /// point whose multiplier lambda_bar holds it off the punch (a gap) by more. True when any was
-    /// updated (the residual changed); false without a tolerance.
+    /// updated (the residual changed); false without a tolerance. With a share the violations are
+    /// the largest over the processes (collective).
     fn augment_violated(&mut self) -> bool {
         let Some(tol) = self.augmented_tolerance else { return false };
+        let mut violation: Vec<f64> = self.contacts.iter().map(|c| c.constraint_violation()).collect();
+        if let Some(share) = &self.share {
+            if let Err(e) = share.reduce.max_f64(&mut violation) {
+                self.pending.get_or_insert(e);
+                return true;
+            }
+        }
         let mut again = false;
-        for c in self.contacts.iter_mut() {
-            if c.constraint_violation() > tol {
+        for (c, v) in self.contacts.iter_mut().zip(violation) {
+            if v > tol {
                 c.augment();
                 again = true;
             }
         }
         again
     }
+
+    /// Sum a force-driven punch's row and column of the tangent and the preconditioner over the
+    /// processes (each added the part of its own points).
+    fn sum_border(&mut self) -> Result<()> {
+        let Some(share) = &self.share else { return Ok(()) };
+        let neq = self.dofs.num_equations();
+        let sym = self.pattern.symbolic();
+        let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+        let mut slots = Vec::new();
+        for b in neq..neq + self.border.len() {
+            for s in col_ptr[b]..col_ptr[b + 1] {
+                slots.push(s);
+                let r = row_idx[s];
+                if r != b {
+                    slots.extend(self.pattern.find(b, r));
+                }
+            }
+        }
+        let with_p = !self.preconditioner.is_empty();
+        let mut buf: Vec<f64> = slots.iter().map(|&s| self.values[s]).collect();
+        if with_p {
+            buf.extend(slots.iter().map(|&s| self.preconditioner[s]));
+        }
+        share.reduce.sum(&mut buf)?;
+        for (k, &s) in slots.iter().enumerate() {
+            self.values[s] = buf[k];
+            if with_p {
+                self.preconditioner[s] = buf[slots.len() + k];
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Whether this process adds the tangent entry (row dof r, column dof c) of a contact or
 /// displacement-dependent load (all of them without a share): those of the rows of its own nodes,
-/// and those of the force-driven punches' rows and columns (dofs from `nd` on) everywhere, which
-/// the bordered solver reads whole on every process.
+/// of a force-driven punch's row (dofs from `nd` on) those of the columns of its own nodes, and
+/// the punch's own entry (the contact adds its part of it). The punch's row and column are summed
+/// over the processes afterwards ([`Model::sum_border`]): the bordered solver reads them whole.
 fn owns_row(share: &Option<Share>, dofs_per_node: usize, nd: usize) -> impl Fn(usize, usize) -> bool + '_ {
-    move |r, c| r >= nd || c >= nd || share.as_ref().is_none_or(|s| s.owned_nodes[r / dofs_per_node])
+    move |r, c| {
+        let node = if r < nd { r } else if c < nd { c } else { return true };
+        share.as_ref().is_none_or(|s| s.owned_nodes[node / dofs_per_node])
+    }
 }
 
 impl<E: Element> NonlinearProblem for Model<E> {
@@ -347,17 +414,15 @@ impl<E: Element> NonlinearProblem for Model<E> {
                 self.reference.extend_from_slice(&u[..nd]);
             }
         }
+        if let Some(e) = self.pending.take() {
+            return Err(e);
+        }
         if let Some(share) = &self.share {
-            // the lowest refusing element of any process, then the whole model's forces and energy
+            // the lowest refusing element of any process (the forces are summed with the
+            // contact forces below)
             let mut r = [refused as u64];
             share.reduce.min(&mut r)?;
             refused = usize::try_from(r[0]).unwrap_or(usize::MAX);
-            if refused == usize::MAX {
-                share.reduce.sum(&mut self.force[..nd])?;
-                let mut e = [energy];
-                share.reduce.sum(&mut e)?;
-                energy = e[0];
-            }
         }
         if refused != usize::MAX {
             if let Some(share) = &self.share {
@@ -368,20 +433,27 @@ impl<E: Element> NonlinearProblem for Model<E> {
             }
             return Err(Assembler::refusal(&self.element, &self.dofs, u, refused));
         }
-        self.energy = energy;
         self.force[nd..].fill(0.0);
-        let internal_norm = self.force.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // with a share: this process's part (the forces are summed below)
+        let mut internal_norm = self.force.iter().map(|x| x * x).sum::<f64>().sqrt();
         let t_contact = Instant::now();
         self.timings.assembly += (t_contact - start).as_secs_f64();
         self.timings.assemblies += 1;
         let mut changes = 0;
         let mut contact_sq = 0.0;
         let mut ext_sq = 0.0;
+        let shared = self.share.is_some();
+        if shared {
+            // this process's contact forces apart from its internal ones (see below)
+            self.contact_force.clear();
+            self.contact_force.resize(self.force.len(), 0.0);
+        }
         {
             let pattern = &self.pattern;
             let dofs = &self.dofs;
             let values = &mut self.values;
             let preconditioner = &mut self.preconditioner;
+            let force = if shared { &mut self.contact_force } else { &mut self.force };
             let eq = |d: usize| if d < nd { dofs.equation(d) } else { Some(neq + d - nd) };
             let mine = owns_row(&self.share, dofs.dofs_per_node(), nd);
             // the contact stiffness is symmetric: it belongs to the preconditioner as it is
@@ -399,13 +471,13 @@ impl<E: Element> NonlinearProblem for Model<E> {
                 }
             };
             for pair in self.contacts.iter_mut() {
-                changes += if with_tangent { pair.evaluate(u, t, &mut self.force, Some(&mut add)) } else { pair.evaluate(u, t, &mut self.force, None) };
+                changes += if with_tangent { pair.evaluate(u, t, force, Some(&mut add))? } else { pair.evaluate(u, t, force, None)? };
                 // an integrated punch whose contact reached points the pattern does not couple:
                 // couple them from the next evaluation on (this tangent lacks those entries)
                 if pair.needs_coupling() {
                     pair.extend_coupling();
                 }
-                contact_sq += pair.force_norm().powi(2);
+                contact_sq += if shared { pair.force_norm_squared() } else { pair.force_norm().powi(2) };
                 if let Some(f) = &pair.drive {
                     ext_sq += (t * f.force).powi(2);
                 }
@@ -439,8 +511,37 @@ impl<E: Element> NonlinearProblem for Model<E> {
             for f in self.follower_force.iter_mut() {
                 *f *= t;
             }
+            if let Some(share) = &self.share {
+                // this process's own nodes' forces, then every process's
+                let dpn = self.dofs.dofs_per_node();
+                for (d, f) in self.follower_force.iter_mut().enumerate() {
+                    if !share.owned_nodes[d / dpn] {
+                        *f = 0.0;
+                    }
+                }
+                share.reduce.sum(&mut self.follower_force)?;
+            }
             ext_sq += self.follower_force.iter().map(|x| x * x).sum::<f64>();
         }
+        if let Some(share) = &self.share {
+            // The whole model's forces: the internal forces of every process's elements and the
+            // contact forces of every process's points, in one sum. The internal forces' norm is
+            // the sum over the processes of their own nodes' part (no other process adds contact
+            // forces there); the contact forces' likewise.
+            for (f, c) in self.force.iter_mut().zip(&self.contact_force) {
+                *f += c;
+            }
+            share.reduce.sum(&mut self.force)?;
+            let dpn = self.dofs.dofs_per_node();
+            let own_internal: f64 = (0..nd).filter(|&d| share.owned_nodes[d / dpn]).map(|d| (self.force[d] - self.contact_force[d]).powi(2)).sum();
+            let mut scalars = [energy, own_internal, contact_sq];
+            share.reduce.sum(&mut scalars)?;
+            [energy, internal_norm, contact_sq] = [scalars[0], scalars[1].sqrt(), scalars[2]];
+            if with_tangent && !self.border.is_empty() {
+                self.sum_border()?;
+            }
+        }
+        self.energy = energy;
         self.timings.contact += t_contact.elapsed().as_secs_f64();
         self.dofs.gather(&self.force[..nd], &mut self.residual[..neq]);
         for (d, &f) in self.follower_force.iter().enumerate() {
@@ -496,7 +597,18 @@ impl<E: Element> NonlinearProblem for Model<E> {
         }
     }
     fn update_active_set(&mut self) -> usize {
-        self.contacts.iter_mut().map(|c| c.update_active_set()).sum()
+        let mut changes = 0;
+        for c in self.contacts.iter_mut() {
+            match c.update_active_set() {
+                Ok(n) => changes += n,
+                // a failed reduction: the next evaluation returns it
+                Err(e) => {
+                    self.pending.get_or_insert(e);
+                    changes += 1;
+                }
+            }
+        }
+        changes
     }
     fn start_step(&mut self, predicted: bool) {
         self.reference.clone_from(&self.converged_u);
@@ -517,6 +629,12 @@ impl<E: Element> NonlinearProblem for Model<E> {
         // converged state's
         self.peak_scale = self.peak_scale.max(self.last_scale);
         self.converged_u.clone_from(&self.last_u);
+        // with a share: every point's state whole on every process (the outputs read it)
+        for c in self.contacts.iter_mut() {
+            if let Err(e) = c.gather_state() {
+                self.pending.get_or_insert(e);
+            }
+        }
         self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone(), c.last_active.clone())).collect();
     }
     fn restore(&mut self) {

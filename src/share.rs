@@ -27,6 +27,25 @@ pub trait Reduce: Send + Sync {
     fn sum(&self, v: &mut [f64]) -> Result<()>;
     /// The smallest of each entry of `v` over the processes, in place.
     fn min(&self, v: &mut [u64]) -> Result<()>;
+    /// The largest of each entry of `v` over the processes, in place (no NaN). Built on
+    /// [`min`](Self::min) through an order-preserving map of the f64 onto u64.
+    fn max_f64(&self, v: &mut [f64]) -> Result<()> {
+        let mut keys: Vec<u64> = v.iter().map(|&x| !order_key(x)).collect();
+        self.min(&mut keys)?;
+        for (x, k) in v.iter_mut().zip(&keys) {
+            *x = from_order_key(!k);
+        }
+        Ok(())
+    }
+    /// The smallest of each entry of `v` over the processes, in place (no NaN).
+    fn min_f64(&self, v: &mut [f64]) -> Result<()> {
+        let mut keys: Vec<u64> = v.iter().map(|&x| order_key(x)).collect();
+        self.min(&mut keys)?;
+        for (x, k) in v.iter_mut().zip(&keys) {
+            *x = from_order_key(*k);
+        }
+        Ok(())
+    }
     /// The text of the one process that passes some (the others pass None), on every process:
     /// the reason an element refused the state, which only its own process can say (the others
     /// may not hold its data). Built on [`min`](Self::min): its bytes in words, the others' all
@@ -49,6 +68,17 @@ pub trait Reduce: Send + Sync {
     }
 }
 
+/// A u64 that orders as the f64 does (for any f64 but NaN): the sign bit flipped on a positive
+/// number, every bit on a negative one.
+fn order_key(x: f64) -> u64 {
+    let b = x.to_bits();
+    if b >> 63 == 1 { !b } else { b | 1 << 63 }
+}
+
+fn from_order_key(k: u64) -> f64 {
+    f64::from_bits(if k >> 63 == 1 { k & !(1 << 63) } else { !k })
+}
+
 /// What one process evaluates.
 #[derive(Clone)]
 pub struct Share {
@@ -58,4 +88,38 @@ pub struct Share {
     /// the node's dofs (each node owned by exactly one process).
     pub owned_nodes: Vec<bool>,
     pub reduce: Arc<dyn Reduce>,
+    /// This process adds what is applied once whatever the share (a force-driven punch's load)
+    /// and prints the debug lines: exactly one process does.
+    pub leader: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One process: every reduction is the identity.
+    struct Alone;
+    impl Reduce for Alone {
+        fn sum(&self, _: &mut [f64]) -> Result<()> {
+            Ok(())
+        }
+        fn min(&self, _: &mut [u64]) -> Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn the_order_key_orders_as_the_numbers_and_comes_back() {
+        let xs = [f64::NEG_INFINITY, -1e300, -2.5, -1e-300, -0.0, 0.0, 1e-300, 3.0, 1e300, f64::INFINITY];
+        for w in xs.windows(2) {
+            assert!(order_key(w[0]) <= order_key(w[1]), "{} {}", w[0], w[1]);
+        }
+        for &x in &xs {
+            assert_eq!(from_order_key(order_key(x)).to_bits(), x.to_bits());
+        }
+        let mut v = xs.to_vec();
+        Alone.max_f64(&mut v).unwrap();
+        Alone.min_f64(&mut v).unwrap();
+        assert_eq!(v, xs);
+    }
 }

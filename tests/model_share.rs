@@ -6,10 +6,19 @@
 //! Each share's pattern is its own, smaller than the whole's, and holds the whole rows of the
 //! nodes it owns. Each share keeps its own elements' data only; an element that refuses the state
 //! on one share gives every share the same error, its reason told by that share.
+//!
+//! The contact points are shared too: each share evaluates the points of its own nodes (and, for
+//! the integrated discretisation, a halo of their cells). Through a scripted run of Newton's calls
+//! -- evaluations with and without a tangent, multiplier updates, an active-set update, a
+//! checkpoint -- every share's residual, norms and counts of changes are the whole model's, and
+//! after the checkpoint every share holds the whole contact state, pressures and reaction; each
+//! share queried the punch's surface at fewer points than the whole model.
 
 mod common;
 use common::*;
-use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive};
+use stamp::contact::{ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
+use stamp::surface::ContactSurface;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use stamp::dofs::DofMap;
 use stamp::element::Element;
 use stamp::error::Result;
@@ -70,7 +79,37 @@ impl Reduce for Threads {
 
 const PARTS: usize = 3;
 
+/// A sphere that counts the points it was queried at.
+struct Counted {
+    sphere: Sphere,
+    queries: AtomicUsize,
+}
+
+impl ContactSurface for Counted {
+    fn psi(&self, x: &nalgebra::Vector3<f64>) -> f64 {
+        self.sphere.psi(x)
+    }
+    fn gradient(&self, x: &nalgebra::Vector3<f64>) -> nalgebra::Vector3<f64> {
+        self.sphere.gradient(x)
+    }
+    fn psi_and_gradient(&self, x: &nalgebra::Vector3<f64>) -> (f64, nalgebra::Vector3<f64>) {
+        self.queries.fetch_add(1, Ordering::Relaxed);
+        self.sphere.psi_and_gradient(x)
+    }
+    fn hessian(&self, x: &nalgebra::Vector3<f64>) -> nalgebra::Matrix3<f64> {
+        self.sphere.hessian(x)
+    }
+}
+
 fn model(mesh: &QuadMesh) -> Model<PlateElements> {
+    let mut m = contact_model(mesh, false, Arc::new(Sphere::new(nalgebra::Vector3::new(1.2, 1.1, 0.1 + 1.0), 1.0).unwrap()));
+    m.contacts[0].entry_fraction = 0.0;
+    m
+}
+
+/// The plate of [`model`] with the punch `surface`, its contact nodal or `integrated`, with the
+/// default active-set rules and an augmented-Lagrangian tolerance.
+fn contact_model(mesh: &QuadMesh, integrated: bool, surface: Arc<dyn ContactSurface>) -> Model<PlateElements> {
     let section = steel_section(0.2);
     let dp = section.delta_plus;
     let plate = PlateElements::new(mesh, section, Kinematics::Nonlinear).unwrap();
@@ -81,12 +120,17 @@ fn model(mesh: &QuadMesh) -> Model<PlateElements> {
     let points = (0..mesh.num_nodes())
         .map(|n| ContactPoint { node: n, x_ref: [mesh.coords[n][0], mesh.coords[n][1], dp], dofs: [0, 1, 2].map(|c| Face::Top.dof(n, c)), weight: areas[n] })
         .collect();
-    let mut pair = ContactPair::new("punch", Arc::new(Sphere::new(nalgebra::Vector3::new(1.2, 1.1, 0.1 + 1.0), 1.0).unwrap()), points, 3.0e3, ContactKinematics::Exact);
-    pair.entry_fraction = 0.0;
+    let mut pair = ContactPair::new("punch", surface, points, 3.0e3, ContactKinematics::Exact);
+    if integrated {
+        let all: Vec<Option<usize>> = (0..mesh.num_nodes()).map(Some).collect();
+        pair = pair.with_face(ContactFace::new(&mesh.coords, &mesh.cells, &all, mesh.num_nodes()).unwrap()).unwrap();
+        pair.coupling_reach = 0.05;
+    }
     pair.drive = Some(ForceDrive::new([0.0, 0.0, -1.0], 7.0).unwrap());
     model.add_contact(pair);
     model.add_follower_load(Box::new(FollowerPressure::new("pressure", &mesh.coords, &mesh.cells, Face::Bottom, -0.1, 40.0)));
     model.want_preconditioner(true);
+    model.augmented_tolerance = Some(1e-4);
     model
 }
 
@@ -103,6 +147,8 @@ fn entries(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Entries {
 
 fn evaluate(model: &mut Model<PlateElements>, u: &[f64]) -> Outcome {
     model.evaluate(u, 1.0, true).map_err(|e| e.to_string())?;
+    // the points' state whole on every share (collective)
+    model.contacts[0].gather_state().map_err(|e| e.to_string())?;
     let active = model.contacts[0].state.iter().map(|s| s.active).collect();
     Ok((model.residual().to_vec(), model.energy(), active, entries(model.matrix()), entries(model.preconditioner().unwrap())))
 }
@@ -120,6 +166,7 @@ fn shared(mesh: &QuadMesh, u: &[f64]) -> (Vec<Outcome>, Vec<u32>) {
                     elements: (0..mesh.num_cells()).filter(|&e| part[e] == k).collect(),
                     owned_nodes: owner.iter().map(|&o| o == k).collect(),
                     reduce: reduce.clone(),
+                    leader: k == 0,
                 };
                 let own: Vec<bool> = part.iter().map(|&q| q == k).collect();
                 s.spawn(move || {
@@ -215,5 +262,137 @@ fn shares_add_up_to_the_whole_model() {
     let want = evaluate(&mut whole, &bad).expect_err("an element refuses");
     for (i, o) in shared(&mesh, &bad).0.iter().enumerate() {
         assert_eq!(o.as_ref().expect_err("refused on every share"), &want, "share {i}");
+    }
+}
+
+/// A sagging plate state (as above) scaled by `depth`, with the punch's unknown `s`.
+fn sag(mesh: &QuadMesh, whole: &Model<PlateElements>, depth: f64, s: f64) -> Vec<f64> {
+    let n = whole.num_dofs();
+    let mut rng = Lcg(11);
+    let mut u = vec![0.0; n];
+    for k in 0..mesh.num_nodes() {
+        let [x, y] = mesh.coords[k];
+        let w = -depth * (x / 2.4) * (1.0 - ((x - 1.2).powi(2) + (y - 1.1).powi(2)) / 3.0);
+        for face in [Face::Top, Face::Bottom] {
+            u[face.dof(k, 2)] = w;
+            u[face.dof(k, 0)] = rng.range(-1e-3, 1e-3) * x;
+            u[face.dof(k, 1)] = rng.range(-1e-3, 1e-3) * x;
+        }
+    }
+    u[n - 1] = s;
+    u
+}
+
+/// What one call of the script gave: the residual, its norm, the force scale, the changes.
+#[derive(Debug, Clone, PartialEq)]
+struct Call {
+    what: &'static str,
+    residual: Vec<f64>,
+    norm: f64,
+    scale: f64,
+    changes: usize,
+}
+
+/// After the script: every point's (psi, lambda, active), the pressures, the reaction.
+type Ending = (Vec<(f64, f64, bool)>, Vec<f64>, [f64; 3]);
+
+/// Newton's calls on a model, in order: a step start, evaluations with and without a tangent
+/// through a contact that grows, the multiplier update, the active-set update, a checkpoint.
+fn script(m: &mut Model<PlateElements>, states: &[Vec<f64>]) -> (Vec<Call>, Ending) {
+    let mut calls = Vec::new();
+    let mut record = |m: &mut Model<PlateElements>, what: &'static str, u: &[f64], tangent: bool| {
+        let ev = m.evaluate(u, 1.0, tangent).unwrap();
+        calls.push(Call { what, residual: m.residual().to_vec(), norm: ev.residual_norm, scale: ev.force_scale, changes: ev.active_changes });
+    };
+    m.checkpoint();
+    m.start_step(false);
+    for (k, u) in states.iter().enumerate() {
+        record(m, "trial", u, false);
+        record(m, "tangent", u, true);
+        if k == 1 {
+            let updated = m.update_multipliers();
+            record(m, if updated { "after an update" } else { "no update" }, u, true);
+        }
+    }
+    let changes = m.update_active_set();
+    calls.push(Call { what: "active-set update", residual: Vec::new(), norm: 0.0, scale: 0.0, changes });
+    m.checkpoint();
+    let c = &m.contacts[0];
+    let state = c.state.iter().map(|s| (s.psi, s.lambda, s.active)).collect();
+    (calls, (state, c.pressures(), c.reaction()))
+}
+
+/// Both discretisations: the shares' scripted runs are the whole model's, each share queried the
+/// surface at its own points (and its halo) only.
+#[test]
+fn shares_evaluate_their_own_contact_points_and_agree_with_the_whole_model() {
+    let mesh = QuadMesh::rectangle(0.0, 2.4, 0.0, 2.2, 12, 11).unwrap();
+    let sphere = || Arc::new(Counted { sphere: Sphere::new(nalgebra::Vector3::new(1.2, 1.1, 0.1 + 1.0), 1.0).unwrap(), queries: AtomicUsize::new(0) });
+    for integrated in [false, true] {
+        let surface = sphere();
+        let mut whole = contact_model(&mesh, integrated, surface.clone());
+        // the punch pressed deeper and deeper into a sagging plate
+        let states: Vec<Vec<f64>> = [(0.06, 0.09), (0.08, 0.12), (0.085, 0.125)]
+            .iter()
+            .map(|&(d, s)| {
+                let mut u = sag(&mesh, &whole, d, s);
+                whole.apply_prescribed(&mut u, 1.0);
+                u
+            })
+            .collect();
+        let (calls, ending) = script(&mut whole, &states);
+        let whole_queries = surface.queries.load(Ordering::Relaxed);
+        let kind = if integrated { "integrated" } else { "nodal" };
+        let active = ending.0.iter().filter(|s| s.2).count();
+        assert!(active >= 6, "{kind}: {active} points in contact at the end");
+        assert!(calls.iter().any(|c| c.what == "after an update"), "{kind}: the script made no multiplier update: {:?}", calls.iter().map(|c| c.what).collect::<Vec<_>>());
+        assert!(calls.iter().any(|c| c.changes > 0), "{kind}: no active-set change in the script");
+        let cells = |e: usize| mesh.cells[e].to_vec();
+        let part = partition_elements(mesh.num_nodes(), mesh.num_cells(), cells, PARTS).unwrap();
+        let owner = node_owners(mesh.num_nodes(), mesh.num_cells(), cells, &part);
+        let reduce = Arc::new(Threads { barrier: Barrier::new(PARTS), sum: Mutex::new(Vec::new()), min: Mutex::new(Vec::new()) });
+        let runs: Vec<(Vec<Call>, Ending, usize)> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..PARTS as u32)
+                .map(|k| {
+                    let share = Share {
+                        elements: (0..mesh.num_cells()).filter(|&e| part[e] == k).collect(),
+                        owned_nodes: owner.iter().map(|&o| o == k).collect(),
+                        reduce: reduce.clone(),
+                        leader: k == 0,
+                    };
+                    let (mesh, states) = (&mesh, &states);
+                    s.spawn(move || {
+                        let surface = sphere();
+                        let mut m = contact_model(mesh, integrated, surface.clone());
+                        m.set_share(Some(share)).unwrap();
+                        let (calls, ending) = script(&mut m, states);
+                        (calls, ending, surface.queries.load(Ordering::Relaxed))
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-11 * scale.max(1e-300);
+        for (i, (c, e, queries)) in runs.iter().enumerate() {
+            assert_eq!(c.len(), calls.len(), "{kind}, share {i}: calls");
+            for (a, b) in c.iter().zip(&calls) {
+                assert_eq!((a.what, a.changes), (b.what, b.changes), "{kind}, share {i}: {} changes", b.what);
+                let scale = b.residual.iter().fold(b.norm, |m, x| m.max(x.abs()));
+                assert!(close(a.norm, b.norm, scale) && close(a.scale, b.scale, b.scale), "{kind}, share {i}, {}: norms {} {} against {} {}", b.what, a.norm, a.scale, b.norm, b.scale);
+                let dr = a.residual.iter().zip(&b.residual).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+                assert!(dr <= 1e-11 * scale, "{kind}, share {i}, {}: residual differs by {dr:e} of {scale:e}", b.what);
+            }
+            let lam = ending.0.iter().fold(0.0f64, |m, s| m.max(s.1.abs()));
+            for (k, (a, b)) in e.0.iter().zip(&ending.0).enumerate() {
+                assert!(a.2 == b.2 && close(a.0, b.0, 1.0) && close(a.1, b.1, lam), "{kind}, share {i}, point {k}: {a:?} against {b:?}");
+            }
+            let q = ending.1.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(e.1.iter().zip(&ending.1).all(|(a, b)| close(*a, *b, q)), "{kind}, share {i}: pressures");
+            let r = ending.2.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(e.2.iter().zip(&ending.2).all(|(a, b)| close(*a, *b, r)), "{kind}, share {i}: reaction {:?} against {:?}", e.2, ending.2);
+            assert!(*queries < whole_queries * 3 / 4, "{kind}, share {i}: the surface queried {queries} times, the whole model {whole_queries}");
+        }
+        let all: usize = runs.iter().map(|r| r.2).sum();
+        assert!(all >= whole_queries, "{kind}: the shares queried {all} times, the whole model {whole_queries}");
     }
 }

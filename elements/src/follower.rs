@@ -70,6 +70,8 @@ pub struct FollowerPressure {
     gauss: [([f64; 4], [[f64; 2]; 4]); 4],
     /// Unknowns per node of the plate (see [`Face::dof_in`]).
     dofs_per_node: usize,
+    /// The cells evaluated (a process's share, see `share_nodes`); None: all.
+    taken: Option<Vec<bool>>,
 }
 
 impl FollowerPressure {
@@ -98,7 +100,7 @@ impl FollowerPressure {
                 -s_face * orient * p(at(0), at(1))
             }));
         }
-        FollowerPressure { name: name.into(), face, cells: cells.to_vec(), x, scale, gauss, dofs_per_node: crate::DOFS_PER_NODE }
+        FollowerPressure { name: name.into(), face, cells: cells.to_vec(), x, scale, gauss, dofs_per_node: crate::DOFS_PER_NODE, taken: None }
     }
     /// The same on a plate with `n` unknowns per node (default: the paper's six).
     pub fn with_dofs_per_node(mut self, n: usize) -> Self {
@@ -112,8 +114,16 @@ impl DeformationDependentLoad for FollowerPressure {
         &self.name
     }
 
+    /// The cells with a node of `own`.
+    fn share_nodes(&mut self, own: Option<&[bool]>) {
+        self.taken = own.map(|own| self.cells.iter().map(|c| c.iter().any(|&n| own.get(n).copied().unwrap_or(false))).collect());
+    }
+
     fn add_force_and_stiffness(&self, u: &[f64], force: &mut [f64], mut tangent: Option<&mut dyn FnMut(usize, usize, f64)>) {
-        for ((cell, x0), scales) in self.cells.iter().zip(&self.x).zip(&self.scale) {
+        for (k, ((cell, x0), scales)) in self.cells.iter().zip(&self.x).zip(&self.scale).enumerate() {
+            if self.taken.as_ref().is_some_and(|t| !t[k]) {
+                continue;
+            }
             let mut dof = [[0usize; 3]; 4];
             let mut x = *x0;
             for a in 0..4 {
@@ -183,12 +193,14 @@ pub struct FollowerCouple {
     h: f64,
     /// Unknowns per node of the plate (see [`Face::dof_in`]).
     dofs_per_node: usize,
+    /// The nodes evaluated (a process's share, see `share_nodes`); None: all.
+    taken: Option<Vec<bool>>,
 }
 
 impl FollowerCouple {
     /// Couples `nodes` = (node, m L_n) on a plate of thickness `h`.
     pub fn new(name: impl Into<String>, nodes: Vec<(usize, [f64; 3])>, h: f64) -> Self {
-        FollowerCouple { name: name.into(), nodes, h, dofs_per_node: crate::DOFS_PER_NODE }
+        FollowerCouple { name: name.into(), nodes, h, dofs_per_node: crate::DOFS_PER_NODE, taken: None }
     }
     /// The same on a plate with `n` unknowns per node (default: the paper's six).
     pub fn with_dofs_per_node(mut self, n: usize) -> Self {
@@ -202,8 +214,16 @@ impl DeformationDependentLoad for FollowerCouple {
         &self.name
     }
 
+    /// The own nodes.
+    fn share_nodes(&mut self, own: Option<&[bool]>) {
+        self.taken = own.map(|own| self.nodes.iter().map(|&(n, _)| own.get(n).copied().unwrap_or(false)).collect());
+    }
+
     fn add_force_and_stiffness(&self, u: &[f64], force: &mut [f64], mut tangent: Option<&mut dyn FnMut(usize, usize, f64)>) {
-        for &(node, m) in &self.nodes {
+        for (k, &(node, m)) in self.nodes.iter().enumerate() {
+            if self.taken.as_ref().is_some_and(|t| !t[k]) {
+                continue;
+            }
             let top = [0, 1, 2].map(|i| Face::Top.dof_in(self.dofs_per_node, node, i));
             let bottom = [0, 1, 2].map(|i| Face::Bottom.dof_in(self.dofs_per_node, node, i));
             let mut d = [0.0, 0.0, self.h];

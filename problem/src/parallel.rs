@@ -175,6 +175,7 @@ pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, lin
             elements: (0..ne).filter(|&e| part[e] == r).collect(),
             owned_nodes: owner.iter().map(|&o| o == r).collect(),
             reduce: std::sync::Arc::new(MpiReduce(petsc)),
+            leader: rank == 0,
         };
         let own: Vec<bool> = part.iter().map(|&q| q == r).collect();
         model.set_share(Some(share))?;

@@ -33,8 +33,10 @@ use std::sync::Arc;
 
 mod face;
 mod motion;
+mod share;
 pub use face::ContactFace;
 pub use motion::{ForceDrive, PunchMotion};
+pub use share::PointShare;
 
 /// How the constraint is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -230,6 +232,8 @@ pub struct ContactPair {
     converged_scale: f64,
     /// Each point's trial multiplier at the last evaluation with a tangent.
     last_trial: Vec<f64>,
+    /// The points this process evaluates in a distributed run (see [`PointShare`]); None: all.
+    share: Option<PointShare>,
 }
 
 /// Psi, its gradient with respect to the displacement of the point (or quadrature point), its
@@ -392,6 +396,7 @@ impl ContactPair {
             gauss_newton_entry: true,
             converged_scale: 0.0,
             last_trial: vec![0.0; n],
+            share: None,
         }
     }
 
@@ -412,6 +417,57 @@ impl ContactPair {
     /// The integrated discretisation's face, if any.
     pub fn face(&self) -> Option<&ContactFace> {
         self.face.as_ref()
+    }
+
+    /// Evaluate only the points of `own` nodes from now on (`own[n]`: this process owns node n),
+    /// with the punch's totals reduced over the processes by `reduce`; `leader`: this process
+    /// adds the force-driven punch's load and prints the debug lines. None: every point again.
+    /// See [`PointShare`].
+    pub fn set_share(&mut self, own: Option<(&[bool], Arc<dyn crate::share::Reduce>, bool)>) {
+        self.share = own.map(|(nodes, reduce, leader)| {
+            let own_points = self.points.iter().map(|p| nodes.get(p.node).copied().unwrap_or(false)).collect();
+            PointShare::new(own_points, self.face.as_ref(), reduce, leader)
+        });
+    }
+
+    /// The points this process evaluates (all without a share).
+    fn evaluates(&self, k: usize) -> bool {
+        self.share.as_ref().is_none_or(|s| s.evaluated[k])
+    }
+
+    /// The points this process owns (all without a share).
+    fn owns(&self, k: usize) -> bool {
+        self.share.as_ref().is_none_or(|s| s.own[k])
+    }
+
+    /// Make every point's state (and the integrated face's kinematics) whole on every process
+    /// from their owners' (collective; nothing without a share): after a converged step, for the
+    /// outputs and [`reaction`](Self::reaction), [`pressures`](Self::pressures),
+    /// [`max_penetration`](Self::max_penetration), which read every point.
+    pub fn gather_state(&mut self) -> crate::Result<()> {
+        let Some(share) = &self.share else { return Ok(()) };
+        let mut buf = vec![0.0; 6 * self.points.len()];
+        for (k, s) in self.state.iter().enumerate().filter(|(k, _)| share.own[*k]) {
+            buf[6 * k..6 * k + 6].copy_from_slice(&[s.psi, s.grad[0], s.grad[1], s.grad[2], s.lambda, f64::from(u8::from(s.active))]);
+        }
+        share.reduce.sum(&mut buf)?;
+        for (s, b) in self.state.iter_mut().zip(buf.chunks_exact(6)) {
+            *s = PointState { psi: b[0], grad: [b[1], b[2], b[3]], lambda: b[4], active: b[5] != 0.0 };
+        }
+        if let Some(face) = &self.face {
+            let n = face.quadrature.len();
+            self.site_scratch.resize(n, (0.0, Vector3::zeros(), 0.0, None));
+            let mut buf = vec![0.0; 5 * n];
+            for (q, site) in self.site_scratch.iter().enumerate().filter(|(q, _)| share.gathers_site[*q]) {
+                buf[5 * q..5 * q + 5].copy_from_slice(&[site.0, site.1[0], site.1[1], site.1[2], site.2]);
+            }
+            share.reduce.sum(&mut buf)?;
+            for ((site, b), &mine) in self.site_scratch.iter_mut().zip(buf.chunks_exact(5)).zip(&share.sites) {
+                let hess = if mine { site.3 } else { None };
+                *site = (b[0], Vector3::new(b[1], b[2], b[3]), b[4], hess);
+            }
+        }
+        Ok(())
     }
 
     /// Groups of nodes whose dofs the contact tangent couples beyond the nodes of one cell: the
@@ -446,6 +502,9 @@ impl ContactPair {
         }
         let mut grew = false;
         for (i, s) in self.state.iter().enumerate() {
+            if !self.evaluates(i) {
+                continue;
+            }
             let g = Vector3::from(s.grad).norm();
             let near = g > 0.0 && s.psi / g <= self.coupling_reach;
             let wanted = near || self.tangent_points.get(i).copied().unwrap_or(false) || s.lambda != 0.0;
@@ -470,7 +529,8 @@ impl ContactPair {
         self.flips.fill(0);
         self.frozen.fill(false);
         self.step_start = true;
-        self.lambda_scale = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
+        // over this process's points: the next evaluation takes the largest over the processes
+        self.lambda_scale = self.state.iter().enumerate().filter(|(k, _)| self.owns(*k)).map(|(_, s)| s.lambda.abs()).fold(0.0, f64::max);
         self.converged_scale = self.lambda_scale;
     }
 
@@ -514,7 +574,21 @@ impl ContactPair {
     /// - t F is added into `force[drive.dof]`). Returns the number of points whose active state
     /// changed against the set of the last evaluation with a tangent (only such an evaluation
     /// records the new set).
-    pub fn evaluate(&mut self, u: &[f64], t: f64, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>) -> usize {
+    ///
+    /// With a share ([`set_share`](Self::set_share); collective) only this process's points are
+    /// evaluated: the forces and tangent rows of its own points, the shares of the force-driven
+    /// punch's row, column and equation (the model sums them over the processes), the number of
+    /// changes of all.
+    pub fn evaluate(&mut self, u: &[f64], t: f64, force: &mut [f64], add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>) -> crate::Result<usize> {
+        let share = self.share.take();
+        let out = self.evaluate_share(u, t, force, add_tangent, share.as_ref());
+        self.share = share;
+        out
+    }
+
+    fn evaluate_share(&mut self, u: &[f64], t: f64, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>, share: Option<&PointShare>) -> crate::Result<usize> {
+        let own = |k: usize| share.is_none_or(|s| s.own[k]);
+        let evaluated = |k: usize| share.is_none_or(|s| s.evaluated[k]);
         let d = Vector3::from(self.punch_displacement(u, t));
         let drive = self.drive;
         let dn = drive.map(|f| Vector3::from(f.direction)).unwrap_or_else(Vector3::zeros);
@@ -523,9 +597,7 @@ impl ContactPair {
         let first = !self.initialized;
         // "near the kink" is 1 % of the largest multiplier now, or of the largest in this step
         // when every point is momentarily inactive (a lone point swinging in and out)
-        let current = self.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
-        self.lambda_scale = self.lambda_scale.max(current);
-        let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
+        let mut current = self.state.iter().enumerate().filter(|(k, _)| own(*k)).map(|(_, s)| s.lambda.abs()).fold(0.0, f64::max);
         let mut any_tangent = false;
         // Psi, its gradient with respect to the point's displacement and to s, and where the
         // Hessian is taken, for every point first (the entry rule below needs the deepest
@@ -549,13 +621,14 @@ impl ContactPair {
         let displacement = |p: &ContactPoint| Vector3::new(u[p.dofs[0]], u[p.dofs[1]], u[p.dofs[2]]);
         match &self.face {
             None => {
-                (kin.par_iter_mut(), self.surface_at_points.par_iter_mut(), points.par_iter()).into_par_iter().with_min_len(512).for_each(|(out, at, p)| {
+                (kin.par_iter_mut(), self.surface_at_points.par_iter_mut(), points.par_iter()).into_par_iter().enumerate().with_min_len(512).filter(|(k, _)| evaluated(*k)).for_each(|(_, (out, at, p))| {
                     *out = site.kinematics(Vector3::from(p.x_ref), displacement(p), at);
                 });
             }
             Some(face) => {
                 sites.resize(face.quadrature.len(), (0.0, Vector3::zeros(), 0.0, None));
-                (sites.par_iter_mut(), self.surface_at_points.par_iter_mut(), face.quadrature.par_iter()).into_par_iter().with_min_len(512).for_each(|(out, at, q)| {
+                let computed = |q: usize| share.is_none_or(|s| s.sites[q]);
+                (sites.par_iter_mut(), self.surface_at_points.par_iter_mut(), face.quadrature.par_iter()).into_par_iter().enumerate().with_min_len(512).filter(|(q, _)| computed(*q)).for_each(|(_, (out, at, q))| {
                     let (mut x_ref, mut disp) = (Vector3::zeros(), Vector3::zeros());
                     for a in 0..4 {
                         let p = &points[q.points[a] as usize];
@@ -565,7 +638,7 @@ impl ContactPair {
                     *out = site.kinematics(x_ref, disp, at);
                 });
                 let sites = &sites;
-                kin.par_iter_mut().enumerate().with_min_len(512).for_each(|(i, out)| {
+                kin.par_iter_mut().enumerate().with_min_len(512).filter(|(i, _)| evaluated(*i)).for_each(|(i, out)| {
                     let (mut psi, mut grad, mut grad_s) = (0.0, Vector3::zeros(), 0.0);
                     for &(q, a) in face.of_point(i) {
                         let w = face.quadrature[q as usize].weight * face.quadrature[q as usize].shape[a as usize];
@@ -591,14 +664,26 @@ impl ContactPair {
         // an outside prediction (`predicted_step`) is not damped at all.
         let damped = with_tangent && !self.hold_active_set && self.entry_fraction > 0.0 && !self.predicted_step;
         let first_touch = self.first_touch_fraction.filter(|_| damped);
-        let empty = first || !self.last_active.iter().zip(&self.frozen).any(|(a, f)| *a || *f);
+        // the most negative trial of the inactive points, the most tensile of the active ones,
+        // how many points are active and how many active or frozen: over this process's points,
+        // then over the processes
+        let trial_of = |k: usize, q: &Kinematics| self.lambda_bar[k] + self.eps_reg * q.0;
+        let mut deepest = kin.iter().enumerate().filter(|(k, _)| own(*k) && (first || (!self.last_active[*k] && !self.frozen[*k]))).map(|(k, q)| trial_of(k, q)).fold(0.0f64, f64::min);
+        let mut most = kin.iter().enumerate().filter(|(k, _)| own(*k) && self.last_active[*k] && !self.frozen[*k]).map(|(k, q)| trial_of(k, q)).fold(0.0f64, f64::max);
+        let mut active_before = (0..self.points.len()).filter(|&k| own(k) && self.last_active[k]).count() as f64;
+        let mut held_before = (0..self.points.len()).filter(|&k| own(k) && (self.last_active[k] || self.frozen[k])).count() as f64;
+        if let Some(sh) = share {
+            let mut m = [current, -deepest, most, self.lambda_scale, self.converged_scale];
+            sh.reduce.max_f64(&mut m)?;
+            [current, deepest, most, self.lambda_scale, self.converged_scale] = [m[0], -m[1], m[2], m[3], m[4]];
+            let mut c = [active_before, held_before];
+            sh.reduce.sum(&mut c)?;
+            [active_before, held_before] = c;
+        }
+        self.lambda_scale = self.lambda_scale.max(current);
+        let band = 1e-2 * if current > 0.0 { current } else { self.lambda_scale };
+        let empty = first || held_before == 0.0;
         let entry_cut = if damped && (!first || first_touch.is_some()) {
-            let deepest = kin
-                .iter()
-                .enumerate()
-                .filter(|(k, _)| first || (!self.last_active[*k] && !self.frozen[*k]))
-                .map(|(k, q)| self.lambda_bar[k] + self.eps_reg * q.0)
-                .fold(0.0f64, f64::min);
             if let (true, Some(f)) = (empty, first_touch) {
                 f * deepest
             } else if let (true, Some(f)) = (self.step_start, self.step_start_entry_fraction) {
@@ -611,19 +696,9 @@ impl ContactPair {
         };
         // Damped release (see `release_fraction`): an active point whose trial turned tensile
         // leaves only where its trial is at least release_fraction times the most tensile one
-        let release_cut = if damped && !first && self.release_fraction > 0.0 {
-            let most = kin
-                .iter()
-                .enumerate()
-                .filter(|(k, _)| self.last_active[*k] && !self.frozen[*k])
-                .map(|(k, q)| self.lambda_bar[k] + self.eps_reg * q.0)
-                .fold(0.0f64, f64::max);
-            self.release_fraction * most
-        } else {
-            0.0
-        };
+        let release_cut = if damped && !first && self.release_fraction > 0.0 { self.release_fraction * most } else { 0.0 };
         // at most one point active before this evaluation: a change is a lone point swinging
-        let lone = !first && self.last_active.iter().filter(|a| **a).count() <= 1;
+        let lone = !first && active_before <= 1.0;
         // for STAMP_DEBUG: points deferred, released, entering, penetrating, held
         let mut tally = [0usize; 5];
         let integrated = self.face.is_some();
@@ -632,6 +707,12 @@ impl ContactPair {
             self.tangent_points.resize(self.points.len(), false);
         }
         for (k, p) in self.points.iter().enumerate() {
+            if !evaluated(k) {
+                continue;
+            }
+            // a halo point (integrated) goes through the same rules as on its owner's process,
+            // which counts it
+            let changes_before = changes;
             let (psi, grad, grad_s, hess) = kin[k];
             let trial = self.lambda_bar[k] + self.eps_reg * psi;
             let was_active = self.last_active[k] && !first;
@@ -646,7 +727,7 @@ impl ContactPair {
             // a tension that fell at least tenfold since the last tangent: the remainder of a
             // convex punch's linearisation converging away, not a lift-off (see CONVERGING_TENSION)
             let converging = self.hold_converging && self.last_trial[k] > 0.0 && trial < CONVERGING_TENSION * self.last_trial[k];
-            if with_tangent {
+            if with_tangent && own(k) {
                 for (i, on) in [deferred, was_active && !wanted, !was_active && wanted, wanted].into_iter().enumerate() {
                     tally[i] += on as usize;
                 }
@@ -671,7 +752,7 @@ impl ContactPair {
                 if !self.hold_after_update {
                     changes += 1;
                 }
-                tally[4] += 1;
+                tally[4] += usize::from(own(k));
                 true
             } else if self.hold_active_set {
                 // the paper's trial and error: the set stays fixed while Newton converges on it
@@ -693,6 +774,9 @@ impl ContactPair {
                 }
                 wanted
             };
+            if !own(k) {
+                changes = changes_before;
+            }
             let lambda = if active { trial } else { 0.0 };
             // an entering point deep inside the punch, or at the first contact: the Gauss-Newton
             // tangent (see DEEP_ENTRY_RATIO)
@@ -712,7 +796,7 @@ impl ContactPair {
             if !active && !near_kink {
                 continue;
             }
-            any_tangent = true;
+            any_tangent |= own(k);
             if integrated {
                 // forces and tangent from the quadrature points below
                 self.tangent_points[k] = true;
@@ -730,30 +814,53 @@ impl ContactPair {
                 point_tangent(&*self.surface, p, drive.as_ref(), &dn, &grad, grad_s, hess.as_ref(), w * self.eps_reg, w * curvature, add);
             }
         }
-        if with_tangent && std::env::var_os("STAMP_DEBUG").is_some() {
-            let act = self.state.iter().filter(|s| s.active).count();
+        let debug = with_tangent && std::env::var_os("STAMP_DEBUG").is_some();
+        let mut act = if debug { self.state.iter().enumerate().filter(|(k, s)| own(*k) && evaluated(*k) && s.active).count() } else { 0 };
+        if let Some(sh) = share {
+            // the changes, whether any point gives a tangent, and the debug counts of every process
+            let mut c = [changes, usize::from(any_tangent), act, tally[0], tally[1], tally[2], tally[3], tally[4]].map(|x| x as f64);
+            sh.reduce.sum(&mut c)?;
+            [changes, act, tally[0], tally[1], tally[2], tally[3], tally[4]] = [c[0], c[2], c[3], c[4], c[5], c[6], c[7]].map(|x| x as usize);
+            any_tangent = c[1] > 0.0;
+        }
+        if debug && share.is_none_or(|s| s.leader) {
             let [deferred, tensile, entering, penetrating, held] = tally;
             eprintln!("  {}: {act} active, {penetrating} penetrating; {entering} would enter ({deferred} deferred), {tensile} would leave ({held} held)", self.name);
         }
         if let Some(f) = &drive {
-            force[f.dof] -= t * f.force;
+            // the load once over the processes
+            if share.is_none_or(|s| s.leader) {
+                force[f.dof] -= t * f.force;
+            }
             // With no point in contact the punch's equation has no stiffness (it floats) and no state
             // is an equilibrium unless t F = 0. Keep the point closest to the punch on its active
             // branch, lambda = lambda_bar + eps Psi even where that pulls: Newton then brings the
             // punch onto the plate in one step instead of creeping towards it. Once a point
             // touches, this stops; at t F = 0 the punch rests touching the plate with no force.
             if !any_tangent {
-                let closest = self
+                let gap = |s: &PointState| s.psi / Vector3::from(s.grad).norm();
+                let mut closest = self
                     .state
                     .iter()
                     .enumerate()
-                    .filter(|(_, s)| Vector3::from(s.grad).norm() > 0.0)
-                    .min_by(|a, b| (a.1.psi / Vector3::from(a.1.grad).norm()).total_cmp(&(b.1.psi / Vector3::from(b.1.grad).norm())))
+                    .filter(|(k, s)| own(*k) && Vector3::from(s.grad).norm() > 0.0)
+                    .min_by(|a, b| gap(a.1).total_cmp(&gap(b.1)))
                     .map(|(k, _)| k);
+                if let Some(sh) = share {
+                    // the closest over the processes (the lowest-numbered point of equal gaps)
+                    let mut g = [closest.map_or(f64::INFINITY, |k| gap(&self.state[k]))];
+                    sh.reduce.min_f64(&mut g)?;
+                    let mut at = [closest.filter(|&k| gap(&self.state[k]) == g[0]).map_or(u64::MAX, |k| k as u64)];
+                    sh.reduce.min(&mut at)?;
+                    closest = usize::try_from(at[0]).ok().filter(|&k| k < self.points.len());
+                }
                 if let (Some(k), true) = (closest, integrated) {
-                    self.state[k].lambda = self.lambda_bar[k] + self.eps_reg * self.state[k].psi;
-                    self.tangent_points[k] = true;
-                } else if let Some(k) = closest {
+                    // on every process that evaluates it (its cells' forces are theirs)
+                    if evaluated(k) {
+                        self.state[k].lambda = self.lambda_bar[k] + self.eps_reg * self.state[k].psi;
+                        self.tangent_points[k] = true;
+                    }
+                } else if let Some(k) = closest.filter(|&k| own(k)) {
                     let p = &self.points[k];
                     let g = Vector3::from(self.state[k].grad);
                     let lambda = self.lambda_bar[k] + self.eps_reg * self.state[k].psi;
@@ -782,7 +889,7 @@ impl ContactPair {
             if with_tangent {
                 self.needs_coupling = self.tangent_points.iter().zip(&self.coupled).any(|(t, c)| *t && !*c);
             }
-            self.add_integrated(&sites, &dn, force, add_tangent);
+            self.add_integrated(&sites, &dn, force, add_tangent, share);
         }
         self.site_scratch = sites;
         if first {
@@ -793,7 +900,7 @@ impl ContactPair {
             self.hold_after_update = false;
         }
         self.kinematics_scratch = kin;
-        changes
+        Ok(changes)
     }
 
     /// The multiplier field lambda_h = sum_a N_a lambda_a at a quadrature point of the face.
@@ -807,29 +914,45 @@ impl ContactPair {
     /// points (and w_q lambda_q dPsi/ds on a force-driven punch) with the curvature tangent
     /// w_q lambda_q N_j N_k H; for every point of `tangent_points` the penalty tangent
     /// eps / A_i a_i a_i^T, a_i = sum_q w_q N_i(q) (N_j(q) grad Psi_q, dPsi_q/ds).
-    fn add_integrated(&self, sites: &[Kinematics], dn: &Vector3<f64>, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>) {
+    ///
+    /// With a share: the quadrature points of the cells around its own points, their forces and
+    /// tangent rows on its own points only, and of the punch's row, column and equation the parts
+    /// of its own points (a quadrature point's by the shape functions of its own points).
+    fn add_integrated(&self, sites: &[Kinematics], dn: &Vector3<f64>, force: &mut [f64], mut add_tangent: Option<&mut dyn FnMut(usize, usize, f64)>, share: Option<&PointShare>) {
         let face = self.face.as_ref().expect("integrated");
         let drive = self.drive;
-        for (q, site) in face.quadrature.iter().zip(sites) {
+        let own = |k: u32| share.is_none_or(|s| s.own[k as usize]);
+        for (k, (q, site)) in face.quadrature.iter().zip(sites).enumerate() {
+            if share.is_some_and(|s| !s.force_sites[k]) {
+                continue;
+            }
             let lambda_q = self.traction_at(q);
             if lambda_q == 0.0 {
                 continue;
             }
             let (_, grad, grad_s, hess_at) = site;
             let wl = q.weight * lambda_q;
-            for a in 0..4 {
+            for a in (0..4).filter(|&a| own(q.points[a])) {
                 let p = &self.points[q.points[a] as usize];
                 for i in 0..3 {
                     force[p.dofs[i]] += wl * q.shape[a] * grad[i];
                 }
             }
+            // this process's part of the quadrature point's share in the punch's equation
+            let part = match share {
+                None => 1.0,
+                Some(_) => (0..4).filter(|&a| own(q.points[a])).map(|a| q.shape[a]).sum::<f64>(),
+            };
             if let Some(f) = &drive {
-                force[f.dof] += wl * grad_s;
+                force[f.dof] += if share.is_none() { wl * grad_s } else { part * wl * grad_s };
             }
             let (Some(add), Some(x)) = (add_tangent.as_deref_mut(), hess_at) else { continue };
             let h = self.surface.hessian(x) * wl;
             let hn = h * dn;
             for a in 0..4 {
+                if !own(q.points[a]) {
+                    continue;
+                }
                 let pa = &self.points[q.points[a] as usize];
                 for b in 0..4 {
                     let pb = &self.points[q.points[b] as usize];
@@ -848,7 +971,7 @@ impl ContactPair {
                 }
             }
             if let Some(f) = &drive {
-                add(f.dof, f.dof, dn.dot(&hn));
+                add(f.dof, f.dof, if share.is_none() { dn.dot(&hn) } else { part * dn.dot(&hn) });
             }
         }
         let Some(add) = add_tangent else { return };
@@ -870,6 +993,9 @@ impl ContactPair {
             }
             let c = self.eps_reg / face.area[i];
             for (j, aj) in a_i.iter().enumerate() {
+                if !own(patch[j]) {
+                    continue;
+                }
                 let pj = &self.points[patch[j] as usize];
                 for (k, ak) in a_i.iter().enumerate() {
                     let pk = &self.points[patch[k] as usize];
@@ -886,7 +1012,7 @@ impl ContactPair {
                     }
                 }
             }
-            if let Some(f) = &drive {
+            if let Some(f) = drive.filter(|_| own(i as u32)) {
                 add(f.dof, f.dof, c * a_s * a_s);
             }
         }
@@ -895,57 +1021,72 @@ impl ContactPair {
     /// The paper's active-set update (eqs. 4.14b, 4.15a) after Newton converged on a fixed set: add
     /// the points with Psi < 0, drop those with lambda > 0. A point that changes `max_flips` times
     /// in one load step is held where it is (it sits at the kink, lambda ~ 0 either way). Returns the
-    /// number of changes.
-    pub fn update_active_set(&mut self) -> usize {
+    /// number of changes (of every process's points: collective with a share).
+    pub fn update_active_set(&mut self) -> crate::Result<usize> {
         let mut changes = 0;
         for k in 0..self.points.len() {
-            if self.frozen[k] {
+            if self.frozen[k] || !self.evaluates(k) {
                 continue;
             }
             let wanted = self.lambda_bar[k] + self.eps_reg * self.state[k].psi <= 0.0;
             if wanted != self.last_active[k] {
                 self.last_active[k] = wanted;
-                changes += 1;
+                changes += usize::from(self.owns(k));
                 record_flip(&mut self.flips[k], &mut self.frozen[k], self.max_flips);
             }
         }
-        changes
+        if let Some(sh) = &self.share {
+            let mut c = [changes as f64];
+            sh.reduce.sum(&mut c)?;
+            changes = c[0] as usize;
+        }
+        Ok(changes)
     }
 
-    /// Augmented-Lagrangian update: lambda_bar <- lambda. Returns the largest penetration (-Psi) of
-    /// the active points before the update.
-    pub fn augment(&mut self) -> f64 {
+    /// Augmented-Lagrangian update: lambda_bar <- lambda (of the points this process evaluates).
+    pub fn augment(&mut self) {
         self.hold_after_update = true;
-        for (lb, s) in self.lambda_bar.iter_mut().zip(&self.state) {
-            *lb = s.lambda;
+        for k in 0..self.points.len() {
+            if self.evaluates(k) {
+                self.lambda_bar[k] = self.state[k].lambda;
+            }
         }
-        self.max_penetration()
     }
 
     /// How far the augmented-Lagrangian multipliers are from converged, as a length: the largest
     /// penetration over all points and the largest gap |Psi| / |grad Psi| of the active points
     /// (an active point with a gap carries more than its share, lambda_bar too large: after
     /// unloading it would press the plate down with a force the load no longer provides).
+    /// With a share: of this process's own points at its last evaluation (the largest over the
+    /// processes is the punch's).
     pub fn constraint_violation(&self) -> f64 {
         let gaps = self
             .state
             .iter()
             .zip(&self.lambda_bar)
-            .filter(|(s, lb)| s.active && **lb < 0.0)
-            .map(|(s, _)| {
+            .enumerate()
+            .filter(|(k, (s, lb))| self.owns(*k) && s.active && **lb < 0.0)
+            .map(|(_, (s, _))| {
                 let g = Vector3::from(s.grad).norm();
                 if g > 0.0 { s.psi.abs() / g } else { 0.0 }
             })
             .fold(0.0, f64::max);
-        gaps.max(self.max_penetration())
+        gaps.max(self.penetration_where(|k| self.owns(k)))
     }
 
     /// The largest penetration max(0, -Psi) over the points, in units of Psi divided by
-    /// |grad Psi| (a length for any surface).
+    /// |grad Psi| (a length for any surface). With a share: of every point after a converged
+    /// step ([`gather_state`](Self::gather_state)).
     pub fn max_penetration(&self) -> f64 {
+        self.penetration_where(|_| true)
+    }
+
+    fn penetration_where(&self, at: impl Fn(usize) -> bool) -> f64 {
         self.state
             .iter()
-            .map(|s| {
+            .enumerate()
+            .filter(|(k, _)| at(*k))
+            .map(|(_, s)| {
                 let g = Vector3::from(s.grad).norm();
                 if g > 0.0 { (-s.psi / g).max(0.0) } else { 0.0 }
             })
@@ -953,14 +1094,22 @@ impl ContactPair {
     }
 
     /// Euclidean norm of the nodal contact forces w lambda grad Psi (the size of the forces in play,
-    /// whether or not they cancel in the total).
+    /// whether or not they cancel in the total). With a share: its square over this process's own
+    /// points is [`force_norm_squared`](Self::force_norm_squared), to be summed over the processes.
     pub fn force_norm(&self) -> f64 {
+        self.force_norm_squared().sqrt()
+    }
+
+    /// The square of [`force_norm`](Self::force_norm) over this process's own points (all without
+    /// a share) at its last evaluation.
+    pub fn force_norm_squared(&self) -> f64 {
         self.points
             .iter()
             .zip(&self.state)
-            .map(|(p, s)| (p.weight * s.lambda).powi(2) * Vector3::from(s.grad).norm_squared())
+            .enumerate()
+            .filter(|(k, _)| self.owns(*k))
+            .map(|(_, (p, s))| (p.weight * s.lambda).powi(2) * Vector3::from(s.grad).norm_squared())
             .sum::<f64>()
-            .sqrt()
     }
 
     /// Total force of the punch on the body, sum of -w lambda grad Psi.
