@@ -128,6 +128,20 @@ elif [ "$(grep -c '^error: Newton-Raphson did not converge' "$work/newton.err")"
 else
   bad "a Newton failure on 2 ranks: $(cat "$work/newton.err")"
 fi
+# a punch whose Psi is not finite at points the plate reaches during the solve (near one corner,
+# which one rank's points reach): one message on 4 ranks, the one-process run's, summary.json failed
+sed -e 's|- 1"$|- 1 + 0 * sqrt(0.7 - x3 + 0.1 * ((20 - x1) + (20 - x2)))"|' -e "s|file = \"|file = \"$PWD/meshes/|" meshes/ellipsoid-expression.toml >"$work/nan.toml"
+grep -q 'sqrt(0.7' "$work/nan.toml" || bad "the Psi-failure problem was not made"
+"$stamp" run "$work/nan.toml" --out "$work/nan-1" -q 2>"$work/nan-1.err"
+if timeout 120 "${mpirun[@]}" -n 4 "$stamp" run "$work/nan.toml" --out "$work/nan" -q 2>"$work/nan.err"; then
+  bad "a Psi failure on 4 ranks: the job succeeded"
+elif [ "$(grep -c '^error: ' "$work/nan.err")" = 1 ] && grep -q "psi is NaN at x = (" "$work/nan.err" && \
+     [ "$(grep '^error: ' "$work/nan.err")" = "$(grep '^error: ' "$work/nan-1.err")" ] && \
+     python3 -c "import json,sys; s=json.load(open('$work/nan/summary.json')); sys.exit(0 if s['status'] == 'failed' and 'psi is NaN' in s['error'] else 1)"; then
+  ok
+else
+  bad "a Psi failure on 4 ranks: $(cat "$work/nan.err") against one process: $(cat "$work/nan-1.err")"
+fi
 # a bad problem file on 4 ranks: one message
 printf '[mesh]\nrectangle = [1, 1]\nno_such_key = 3\n' >"$work/bad.toml"
 if timeout 120 "${mpirun[@]}" -n 4 "$stamp" run "$work/bad.toml" -q 2>"$work/bad.err"; then

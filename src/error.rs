@@ -53,6 +53,10 @@ pub enum StampError {
     /// need more ([`crate::nonlinear::NewtonSettings::max_steps`]).
     #[error("the load path was stopped after load step {steps} (load factor {load_factor:.6e}): {reason}")]
     StepLimit { steps: usize, load_factor: f64, reason: String },
+    /// An error raised by another process of a distributed run, as it told it (the same message
+    /// on every process).
+    #[error("{0}")]
+    Remote(String),
     /// An I/O error with the path it concerns.
     #[error("{}: {source}", short_path(path))]
     Io {

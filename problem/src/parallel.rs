@@ -86,7 +86,7 @@ pub fn agree<T>(local: Result<T>) -> Result<T> {
         if p.size() > 1 {
             return match p.agree(local.as_ref().map(|_| ()).map_err(|e| e.to_string())) {
                 Ok(()) => local,
-                Err(message) => Err(local.err().unwrap_or(stamp::StampError::Problem(message))),
+                Err(message) => Err(local.err().unwrap_or(stamp::StampError::Remote(message))),
             };
         }
     }

@@ -302,7 +302,13 @@ fn json_err(e: serde_json::Error) -> StampError {
 
 /// The default output folder: `<problem dir>/<problem stem>-out`.
 /// The first punch whose surface reports a non-finite evaluation, as an error at its `psi` key.
+/// Collective under MPI: each rank evaluates its own contact points, so a failure one rank saw is
+/// told on every rank.
 fn surface_failure(p: &Problem, contacts: &[stamp::contact::ContactPair]) -> Option<StampError> {
+    super::parallel::agree(own_surface_failure(p, contacts).map_or(Ok(()), Err)).err()
+}
+
+fn own_surface_failure(p: &Problem, contacts: &[stamp::contact::ContactPair]) -> Option<StampError> {
     contacts.iter().enumerate().find_map(|(i, c)| {
         let m = c.surface.evaluation_error()?;
         let key = format!("punch[{i}].psi");
@@ -525,6 +531,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         // a punch whose Psi was not finite somewhere (an expression's sqrt of a negative number)
         // stops the run: its answer would be wrong
         if surface_error.is_none() {
+            // (psi_checks reads the points' state, whole on every rank after the step)
             surface_error = surface_failure(p, &m.contacts)
                 .or_else(|| super::psi_checks::after_step(p, &mesh, &m.contacts, &layout, size, rep.step, (t_last, &u_prev), (rep.load_factor, u)));
             if surface_error.is_some() {
