@@ -7,12 +7,17 @@
 //! ([`crate::model::Model::set_share`]) a process evaluates only its own elements; their internal
 //! forces and energy are summed over the processes ([`Reduce::sum`]) before anything reads them, so
 //! the residual, the reactions, the energy and every test on them are the whole model's on every
-//! process. The contact points and the displacement-dependent loads are evaluated on every
-//! process (their state -- active sets, multipliers, pressures -- is the same everywhere by
-//! construction); each process adds only the tangent rows of the nodes it owns. So the sparse
-//! tangent and preconditioner values a process holds are its share of the nodal block (the sum
-//! over the processes is the whole matrix: a distributed solver adds them), while the rows and
-//! columns of the force-driven punches' unknowns are whole on every process. The pattern a
+//! process. A process evaluates the contact points of the nodes it owns
+//! ([`crate::contact::PointShare`]: with a halo for the integrated discretisation) and the pieces
+//! of the displacement-dependent loads at its nodes
+//! ([`crate::follower::DeformationDependentLoad::share_nodes`]); what the active-set rules and
+//! Newton read of a whole punch is reduced over the processes, the contact forces are summed with
+//! the internal ones, and each process adds only the tangent rows of the nodes it owns. So the
+//! sparse tangent and preconditioner values a process holds are its share of the nodal block (the
+//! sum over the processes is the whole matrix: a distributed solver adds them), while the rows and
+//! columns of the force-driven punches' unknowns are summed to the whole on every process. After
+//! each converged step ([`crate::nonlinear::NonlinearProblem::checkpoint`]) every contact point's
+//! state is whole on every process. The pattern a
 //! process holds is its own (its value arrays are sized to it): the entries of its elements and
 //! of every element around a node it owns (so the rows of its nodes are whole: a distributed
 //! solver preallocates them from it), with the force-driven punches' rows and columns.

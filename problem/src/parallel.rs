@@ -9,20 +9,20 @@
 //!
 //! What is distributed ([`share`], on P > 1 ranks): METIS splits the mesh's elements into P
 //! parts and each rank evaluates only its own elements (internal forces, tangent, the plate's P);
-//! the forces and the energy are summed over the ranks (MPI) right after, so every rank holds the
-//! whole residual. Each node belongs to the rank of the lowest-numbered element around it: that
-//! rank adds the node's contact and follower-load tangent rows, and PETSc keeps the node's rows of
-//! the distributed matrices there, so each rank's share of the tangent goes mostly into its own
-//! rows (PETSc adds the shares: `stamp_petsc::PetscSolver::set_partition`). MUMPS's factorisation
-//! and the Krylov iterations are distributed too.
+//! each node belongs to the rank of the lowest-numbered element around it, and a rank evaluates
+//! the contact points and the follower-load pieces at its own nodes (`stamp::share`). The forces
+//! and the energy are summed over the ranks (MPI) right after, so every rank holds the whole
+//! residual; what the active-set rules read of a whole punch is reduced likewise. PETSc keeps a
+//! node's rows of the distributed matrices on its rank, so each rank's share of the tangent goes
+//! mostly into its own rows (PETSc adds the shares: `stamp_petsc::PetscSolver::set_partition`).
+//! MUMPS's factorisation and the Krylov iterations are distributed too.
 //!
-//! What is replicated: every rank reads the problem and holds the whole mesh, model, sparse
-//! pattern and value arrays (zeros outside its share); the contact search and the
-//! follower loads are evaluated on every rank (their states -- active sets, multipliers -- are the
-//! same everywhere by construction), and every rank runs the same Newton iterations on the
-//! gathered solution; so the active sets, the augmented-Lagrangian updates, the line search and
-//! every convergence test are the same on every rank (PetscSolver checks that the right-hand sides
-//! agree to the bit). The outputs are computed and written by rank 0 only ([`writes_outputs`]).
+//! What is replicated: every rank reads the problem and holds the whole mesh, the vectors of one
+//! entry per unknown and per contact point, and runs the same Newton iterations on the gathered
+//! solution with the same summed residual; so the active sets' counts, the augmented-Lagrangian
+//! updates, the line search and every convergence test are the same on every rank (PetscSolver
+//! checks that the right-hand sides agree to the bit). The outputs are computed and written by
+//! rank 0 only ([`writes_outputs`]), from the contact state gathered after each step.
 //! A failure in the solve is agreed over the ranks; one in writing (rank 0 only) is agreed where
 //! it happens ([`on_writer`]) or stops every rank after the step ([`any_rank`]).
 
