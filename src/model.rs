@@ -94,10 +94,17 @@ pub struct Model<E: Element> {
     /// With a share: a failed reduction in a step that cannot return it (an active-set update, a
     /// checkpoint), returned by the next evaluation.
     pending: Option<StampError>,
+    /// The pattern is built (at the first evaluation, after a share is set: a shared model never
+    /// holds the whole model's pattern, 8 bytes per entry).
+    pattern_ready: bool,
+    /// The preconditioner was asked for ([`NonlinearProblem::want_preconditioner`]): its values
+    /// are sized with the pattern.
+    wants_preconditioner: bool,
 }
 
 impl<E: Element> Model<E> {
-    /// Build the pattern and the element colouring.
+    /// Check the connectivity and build the element colouring; the sparse pattern is built at the
+    /// first evaluation ([`NonlinearProblem::evaluate`]), after a share is set if one is.
     pub fn new(element: E, dofs: DofMap) -> Result<Self> {
         if element.dofs_per_node() != dofs.dofs_per_node() {
             return Err(StampError::Problem(format!(
@@ -109,12 +116,11 @@ impl<E: Element> Model<E> {
         if dofs.num_equations() == 0 {
             return Err(StampError::Problem("every dof is prescribed: nothing to solve".into()));
         }
-        let pattern = SparsePattern::new(&dofs, element.num_elements(), element.nodes_per_element(), |e| element.element_nodes(e).to_vec())?;
+        SparsePattern::check_elements(dofs.num_nodes(), element.num_elements(), element.nodes_per_element(), |e| element.element_nodes(e).to_vec())?;
         let assembler = Assembler::new(&element, dofs.num_nodes());
-        let nnz = pattern.nnz();
         Ok(Model {
             force: vec![0.0; dofs.num_dofs()],
-            values: vec![0.0; nnz],
+            values: Vec::new(),
             preconditioner: Vec::new(),
             residual: vec![0.0; dofs.num_equations()],
             element,
@@ -124,7 +130,7 @@ impl<E: Element> Model<E> {
             follower_loads: Vec::new(),
             follower_force: Vec::new(),
             augmented_tolerance: None,
-            pattern,
+            pattern: SparsePattern::empty(),
             border: Vec::new(),
             coupled: Vec::new(),
             assembler,
@@ -141,6 +147,8 @@ impl<E: Element> Model<E> {
             mixed_tangent: false,
             contact_force: Vec::new(),
             pending: None,
+            pattern_ready: false,
+            wants_preconditioner: false,
         })
     }
 
@@ -180,7 +188,7 @@ impl<E: Element> Model<E> {
     pub fn add_contact(&mut self, pair: ContactPair) {
         self.contacts.push(pair);
         self.share_loads();
-        self.sync_drives();
+        self.number_drives();
     }
 
     /// Give the punches and the displacement-dependent loads this process's share (see
@@ -200,14 +208,9 @@ impl<E: Element> Model<E> {
         self.contacts.iter().filter(|c| c.drive.is_some()).count()
     }
 
-    /// Number each force-driven punch's unknown and border the pattern for them (when they
-    /// changed), and couple the nodes of the integrated punches' patches in it.
-    fn sync_drives(&mut self) {
-        let coupled: Vec<(usize, u64)> = self.contacts.iter().enumerate().filter(|(_, c)| c.face().is_some()).map(|(i, c)| (i, c.coupling_version())).collect();
-        if coupled != self.coupled {
-            self.coupled = coupled;
-            self.rebuild_pattern();
-        }
+    /// Number each force-driven punch's unknown (after the nodal dofs) and size the force and
+    /// residual vectors for them; the signature (index in `contacts`, points) of each.
+    fn number_drives(&mut self) -> Vec<(usize, usize)> {
         let nd = self.dofs.num_dofs();
         let mut sig = Vec::new();
         for (i, c) in self.contacts.iter_mut().enumerate() {
@@ -216,6 +219,21 @@ impl<E: Element> Model<E> {
                 sig.push((i, c.points.len()));
             }
         }
+        self.force.resize(nd + sig.len(), 0.0);
+        self.residual.resize(self.dofs.num_equations() + sig.len(), 0.0);
+        sig
+    }
+
+    /// Number each force-driven punch's unknown and border the pattern for them (when they
+    /// changed), and couple the nodes of the integrated punches' patches in it; the pattern is
+    /// built here the first time.
+    fn sync_drives(&mut self) {
+        let coupled: Vec<(usize, u64)> = self.contacts.iter().enumerate().filter(|(_, c)| c.face().is_some()).map(|(i, c)| (i, c.coupling_version())).collect();
+        if coupled != self.coupled || !self.pattern_ready {
+            self.coupled = coupled;
+            self.rebuild_pattern();
+        }
+        let sig = self.number_drives();
         if sig == self.border {
             return;
         }
@@ -230,13 +248,13 @@ impl<E: Element> Model<E> {
             self.pattern = unbordered.as_ref().unwrap_or(&self.pattern).bordered(&self.dofs, &border);
         }
         self.border = sig;
-        let nb = self.border.len();
-        self.force.resize(nd + nb, 0.0);
-        self.residual.resize(self.dofs.num_equations() + nb, 0.0);
+        self.size_values();
+    }
+
+    /// The value arrays sized to the pattern (the preconditioner's if it was asked for).
+    fn size_values(&mut self) {
         self.values = vec![0.0; self.pattern.nnz()];
-        if !self.preconditioner.is_empty() {
-            self.preconditioner = vec![0.0; self.pattern.nnz()];
-        }
+        self.preconditioner = if self.wants_preconditioner && self.element.has_preconditioner() { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
     }
 
     /// Build the nodal pattern again (the elements of [`pattern_elements`](Self::pattern_elements)
@@ -251,14 +269,12 @@ impl<E: Element> Model<E> {
             None => SparsePattern::coupled(&self.dofs, ne, npe, nodes, &groups),
             Some(subset) => SparsePattern::coupled_subset(&self.dofs, ne, npe, nodes, &groups, subset),
         }
-        .expect("the element pattern was built before; contact points are nodes of the model");
+        .expect("the connectivity was checked (Model::new); contact points are nodes of the model");
         self.pattern = nodal;
+        self.pattern_ready = true;
         // border again in sync_drives, and size the values
         self.border.clear();
-        self.values = vec![0.0; self.pattern.nnz()];
-        if !self.preconditioner.is_empty() {
-            self.preconditioner = vec![0.0; self.pattern.nnz()];
-        }
+        self.size_values();
     }
 
     /// Strain energy at the last evaluation.
@@ -266,7 +282,7 @@ impl<E: Element> Model<E> {
         self.energy
     }
 
-    /// The sparsity pattern.
+    /// The sparsity pattern (empty before the first evaluation).
     pub fn pattern(&self) -> &SparsePattern {
         &self.pattern
     }
@@ -274,9 +290,9 @@ impl<E: Element> Model<E> {
     /// Evaluate only this process's share of the model from now on (see [`crate::share`]: its
     /// elements, and the contact and displacement-dependent-load tangent rows of its nodes, with
     /// the forces and energy summed over the processes); None: the whole model again. The
-    /// sparse pattern and its value arrays shrink to the share's entries: those of its own
-    /// elements and the whole rows of its own nodes (every element around them), the rows and
-    /// columns of the force-driven punches whole.
+    /// sparse pattern and its value arrays, built at the next evaluation, hold the share's
+    /// entries: those of its own elements and the whole rows of its own nodes (every element
+    /// around them), the rows and columns of the force-driven punches whole.
     pub fn set_share(&mut self, share: Option<Share>) -> Result<()> {
         let (ne, nn) = (self.element.num_elements(), self.dofs.num_nodes());
         self.assembler = match &share {
@@ -301,8 +317,12 @@ impl<E: Element> Model<E> {
         });
         self.share = share;
         self.share_loads();
-        self.rebuild_pattern();
-        self.sync_drives();
+        // the share's pattern is built at the next evaluation
+        self.pattern = SparsePattern::empty();
+        self.pattern_ready = false;
+        self.border.clear();
+        self.values = Vec::new();
+        self.preconditioner = Vec::new();
         Ok(())
     }
 
@@ -584,8 +604,9 @@ impl<E: Element> NonlinearProblem for Model<E> {
     }
     /// Allocates (or frees) the preconditioner's values; the element must have one.
     fn want_preconditioner(&mut self, on: bool) {
+        self.wants_preconditioner = on;
         let on = on && self.element.has_preconditioner();
-        if on != !self.preconditioner.is_empty() {
+        if self.pattern_ready && on != !self.preconditioner.is_empty() {
             self.preconditioner = if on { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
         }
     }

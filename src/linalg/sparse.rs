@@ -23,6 +23,34 @@ pub struct SparsePattern {
 }
 
 impl SparsePattern {
+    /// The pattern of no equation (a model's before its first evaluation).
+    pub fn empty() -> Self {
+        SparsePattern { symbolic: SymbolicSparseColMat::new_checked(0, 0, vec![0], None, Vec::new()), block_start: Vec::new(), rank: Vec::new(), nodes_per_element: 0 }
+    }
+
+    /// Check the connectivity a pattern is built from: every element has `nodes_per_element`
+    /// nodes below `num_nodes`, and every node belongs to some element (a stray point in a mesh
+    /// file would be held by nothing).
+    pub fn check_elements(num_nodes: usize, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>) -> Result<()> {
+        let mut used = vec![false; num_nodes];
+        for e in 0..num_elements {
+            let nodes = element_nodes(e);
+            if nodes.len() != nodes_per_element {
+                return Err(StampError::Mesh(format!("element {e} has {} nodes, expected {nodes_per_element}", nodes.len())));
+            }
+            for &a in &nodes {
+                if a >= num_nodes {
+                    return Err(StampError::Mesh(format!("element {e} refers to node {a}, the model has {num_nodes}")));
+                }
+                used[a] = true;
+            }
+        }
+        match used.iter().position(|u| !u) {
+            Some(orphan) => Err(StampError::Mesh(format!("node {orphan} belongs to no element, so nothing holds it (a stray point in the mesh file?)"))),
+            None => Ok(()),
+        }
+    }
+
     /// Build the pattern of the matrix coupling all dofs of nodes that share an element.
     pub fn new(dofs: &DofMap, num_elements: usize, nodes_per_element: usize, element_nodes: impl Fn(usize) -> Vec<usize>) -> Result<Self> {
         Self::coupled(dofs, num_elements, nodes_per_element, element_nodes, &[])
@@ -52,6 +80,7 @@ impl SparsePattern {
         let nn = dofs.num_nodes();
         let dpn = dofs.dofs_per_node();
         let npe = nodes_per_element;
+        Self::check_elements(nn, num_elements, npe, &element_nodes)?;
         let taken = |e: usize| subset.is_none_or(|s| s[e]);
         // node adjacency (each node of the pattern is its own neighbour; without a subset, every
         // node is of the pattern)
@@ -59,20 +88,13 @@ impl SparsePattern {
         let mut conn = Vec::with_capacity(num_elements * npe);
         for e in 0..num_elements {
             let nodes = element_nodes(e);
-            if nodes.len() != npe {
-                return Err(StampError::Mesh(format!("element {e} has {} nodes, expected {npe}", nodes.len())));
-            }
-            for &a in &nodes {
-                if a >= nn {
-                    return Err(StampError::Mesh(format!("element {e} refers to node {a}, the model has {nn}")));
-                }
-                if taken(e) {
+            if taken(e) {
+                for &a in &nodes {
                     count[a] = count[a].max(1) + npe - 1;
                 }
             }
             conn.extend_from_slice(&nodes);
         }
-        let orphan = (0..nn).find(|&i| count[i] == 1).filter(|_| subset.is_none());
         for g in couplings {
             if let Some(&a) = g.iter().find(|&&a| a >= nn) {
                 return Err(StampError::Mesh(format!("a coupling refers to node {a}, the model has {nn}")));
@@ -85,11 +107,6 @@ impl SparsePattern {
             for &a in g.iter() {
                 count[a] = count[a].max(1) + g.len() - 1;
             }
-        }
-        if let Some(orphan) = orphan {
-            return Err(StampError::Mesh(format!(
-                "node {orphan} belongs to no element, so nothing holds it (a stray point in the mesh file?)"
-            )));
         }
         let mut start = vec![0usize; nn + 1];
         for i in 0..nn {
