@@ -132,7 +132,7 @@ fi
 # which one rank's points reach): one message on 4 ranks, the one-process run's, summary.json failed
 sed -e 's|- 1"$|- 1 + 0 * sqrt(0.7 - x3 + 0.1 * ((20 - x1) + (20 - x2)))"|' -e "s|file = \"|file = \"$PWD/meshes/|" meshes/ellipsoid-expression.toml >"$work/nan.toml"
 grep -q 'sqrt(0.7' "$work/nan.toml" || bad "the Psi-failure problem was not made"
-"$stamp" run "$work/nan.toml" --out "$work/nan-1" -q 2>"$work/nan-1.err"
+"$stamp" run "$work/nan.toml" --out "$work/nan-1" -q 2>"$work/nan-1.err" && bad "the Psi-failure problem ran to its end on one process"
 if timeout 120 "${mpirun[@]}" -n 4 "$stamp" run "$work/nan.toml" --out "$work/nan" -q 2>"$work/nan.err"; then
   bad "a Psi failure on 4 ranks: the job succeeded"
 elif [ "$(grep -c '^error: ' "$work/nan.err")" = 1 ] && grep -q "psi is NaN at x = (" "$work/nan.err" && \
