@@ -153,22 +153,34 @@ fn evaluate(model: &mut Model<PlateElements>, u: &[f64]) -> Outcome {
     Ok((model.residual().to_vec(), model.energy(), active, entries(model.matrix()), entries(model.preconditioner().unwrap())))
 }
 
-/// Each share's outcome at `u`, and the owner of every node.
-fn shared(mesh: &QuadMesh, u: &[f64]) -> (Vec<Outcome>, Vec<u32>) {
+/// The PARTS shares of METIS's partition of the mesh over one reduction, each with its elements'
+/// flags; and the owner of every node.
+fn shares(mesh: &QuadMesh) -> (Vec<(Share, Vec<bool>)>, Vec<u32>) {
     let cells = |e: usize| mesh.cells[e].to_vec();
     let part = partition_elements(mesh.num_nodes(), mesh.num_cells(), cells, PARTS).unwrap();
     let owner = node_owners(mesh.num_nodes(), mesh.num_cells(), cells, &part);
     let reduce = Arc::new(Threads { barrier: Barrier::new(PARTS), sum: Mutex::new(Vec::new()), min: Mutex::new(Vec::new()) });
+    let shares = (0..PARTS as u32)
+        .map(|k| {
+            let share = Share {
+                elements: (0..mesh.num_cells()).filter(|&e| part[e] == k).collect(),
+                owned_nodes: owner.iter().map(|&o| o == k).collect(),
+                reduce: reduce.clone(),
+                leader: k == 0,
+            };
+            (share, part.iter().map(|&q| q == k).collect())
+        })
+        .collect();
+    (shares, owner)
+}
+
+/// Each share's outcome at `u`, and the owner of every node.
+fn shared(mesh: &QuadMesh, u: &[f64]) -> (Vec<Outcome>, Vec<u32>) {
+    let (shares, owner) = shares(mesh);
     let outcomes = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..PARTS as u32)
-            .map(|k| {
-                let share = Share {
-                    elements: (0..mesh.num_cells()).filter(|&e| part[e] == k).collect(),
-                    owned_nodes: owner.iter().map(|&o| o == k).collect(),
-                    reduce: reduce.clone(),
-                    leader: k == 0,
-                };
-                let own: Vec<bool> = part.iter().map(|&q| q == k).collect();
+        let handles: Vec<_> = shares
+            .into_iter()
+            .map(|(share, own)| {
                 s.spawn(move || {
                     let mut m = model(mesh);
                     m.set_share(Some(share)).unwrap();
@@ -347,19 +359,11 @@ fn shares_evaluate_their_own_contact_points_and_agree_with_the_whole_model() {
         assert!(active >= 6, "{kind}: {active} points in contact at the end");
         assert!(calls.iter().any(|c| c.what == "after an update"), "{kind}: the script made no multiplier update: {:?}", calls.iter().map(|c| c.what).collect::<Vec<_>>());
         assert!(calls.iter().any(|c| c.changes > 0), "{kind}: no active-set change in the script");
-        let cells = |e: usize| mesh.cells[e].to_vec();
-        let part = partition_elements(mesh.num_nodes(), mesh.num_cells(), cells, PARTS).unwrap();
-        let owner = node_owners(mesh.num_nodes(), mesh.num_cells(), cells, &part);
-        let reduce = Arc::new(Threads { barrier: Barrier::new(PARTS), sum: Mutex::new(Vec::new()), min: Mutex::new(Vec::new()) });
         let runs: Vec<(Vec<Call>, Ending, usize)> = std::thread::scope(|s| {
-            let handles: Vec<_> = (0..PARTS as u32)
-                .map(|k| {
-                    let share = Share {
-                        elements: (0..mesh.num_cells()).filter(|&e| part[e] == k).collect(),
-                        owned_nodes: owner.iter().map(|&o| o == k).collect(),
-                        reduce: reduce.clone(),
-                        leader: k == 0,
-                    };
+            let handles: Vec<_> = shares(&mesh)
+                .0
+                .into_iter()
+                .map(|(share, _)| {
                     let (mesh, states) = (&mesh, &states);
                     s.spawn(move || {
                         let surface = sphere();
