@@ -367,9 +367,8 @@ impl<E: Element> Model<E> {
         let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
         let mut slots = Vec::new();
         for b in neq..neq + self.border.len() {
-            for s in col_ptr[b]..col_ptr[b + 1] {
+            for (s, &r) in row_idx.iter().enumerate().take(col_ptr[b + 1]).skip(col_ptr[b]) {
                 slots.push(s);
-                let r = row_idx[s];
                 if r != b {
                     slots.extend(self.pattern.find(b, r));
                 }
@@ -606,7 +605,7 @@ impl<E: Element> NonlinearProblem for Model<E> {
     fn want_preconditioner(&mut self, on: bool) {
         self.wants_preconditioner = on;
         let on = on && self.element.has_preconditioner();
-        if self.pattern_ready && on != !self.preconditioner.is_empty() {
+        if self.pattern_ready && on == self.preconditioner.is_empty() {
             self.preconditioner = if on { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
         }
     }

@@ -570,8 +570,8 @@ impl ContactPair {
     /// factor `t`, add the contact forces lambda * w * grad Psi into `force` and, through
     /// `add_tangent(row, col, value)` (indices into `u`), the tangent w (eps G G^T + lambda H) of the
     /// active points, G and H the gradient and Hessian of Psi with respect to the point's
-    /// displacement (and to s for a force-driven punch, whose equation R_s = sum w lambda dPsi/ds
-    /// - t F is added into `force[drive.dof]`). Returns the number of points whose active state
+    /// displacement (and to s for a force-driven punch, whose equation
+    /// R_s = sum w lambda dPsi/ds - t F is added into `force[drive.dof]`). Returns the number of points whose active state
     /// changed against the set of the last evaluation with a tangent (only such an evaluation
     /// records the new set).
     ///
