@@ -1186,4 +1186,19 @@ mod tests {
         assert_eq!(summary.steps, 4);
         assert!((u[0] - 1.0).abs() < 1e-12);
     }
+
+    #[test]
+    fn the_secant_scale_is_the_fit_of_the_last_step_clamped_and_whole_when_good() {
+        let s = [2.0, -1.0, 0.5];
+        let start = [1.0, 1.0, 1.0];
+        // the converged increment = f times the secant: the fit is f
+        let scale = |f: f64| secant_scale(&s, &s.iter().zip(&start).map(|(d, a)| a + f * d).collect::<Vec<_>>(), &start);
+        assert!((scale(0.5) - 0.5).abs() < 1e-12, "{}", scale(0.5));
+        assert!((scale(0.3) - 0.3).abs() < 1e-12);
+        assert_eq!(scale(0.05), SECANT_FIT_MIN, "an overshoot of twentyfold is scaled by the floor");
+        assert_eq!(scale(-0.4), SECANT_FIT_MIN, "a secant pointing the wrong way");
+        assert_eq!(scale(0.95), 1.0, "a good secant stays whole");
+        assert_eq!(scale(1.7), 1.0, "an undershoot is not amplified");
+        assert_eq!(secant_scale(&[0.0; 3], &start, &start), 1.0, "no secant");
+    }
 }
