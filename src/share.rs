@@ -32,17 +32,16 @@ pub trait Reduce: Send + Sync {
     fn sum(&self, v: &mut [f64]) -> Result<()>;
     /// The smallest of each entry of `v` over the processes, in place.
     fn min(&self, v: &mut [u64]) -> Result<()>;
-    /// The largest of each entry of `v` over the processes, in place (no NaN). Built on
-    /// [`min`](Self::min) through an order-preserving map of the f64 onto u64.
+    /// The largest of each entry of `v` over the processes, in place (no NaN): minus the smallest
+    /// of their negatives.
     fn max_f64(&self, v: &mut [f64]) -> Result<()> {
-        let mut keys: Vec<u64> = v.iter().map(|&x| !order_key(x)).collect();
-        self.min(&mut keys)?;
-        for (x, k) in v.iter_mut().zip(&keys) {
-            *x = from_order_key(!k);
-        }
+        v.iter_mut().for_each(|x| *x = -*x);
+        self.min_f64(v)?;
+        v.iter_mut().for_each(|x| *x = -*x);
         Ok(())
     }
-    /// The smallest of each entry of `v` over the processes, in place (no NaN).
+    /// The smallest of each entry of `v` over the processes, in place (no NaN). Built on
+    /// [`min`](Self::min) through an order-preserving map of the f64 onto u64.
     fn min_f64(&self, v: &mut [f64]) -> Result<()> {
         let mut keys: Vec<u64> = v.iter().map(|&x| order_key(x)).collect();
         self.min(&mut keys)?;

@@ -938,13 +938,14 @@ impl ContactPair {
                     force[p.dofs[i]] += wl * q.shape[a] * grad[i];
                 }
             }
-            // this process's part of the quadrature point's share in the punch's equation
+            // this process's part of the quadrature point's share in the punch's equation (1 times
+            // a number is that number: the whole model's sums are unchanged)
             let part = match share {
                 None => 1.0,
                 Some(_) => (0..4).filter(|&a| own(q.points[a])).map(|a| q.shape[a]).sum::<f64>(),
             };
             if let Some(f) = &drive {
-                force[f.dof] += if share.is_none() { wl * grad_s } else { part * wl * grad_s };
+                force[f.dof] += part * wl * grad_s;
             }
             let (Some(add), Some(x)) = (add_tangent.as_deref_mut(), hess_at) else { continue };
             let h = self.surface.hessian(x) * wl;
@@ -971,7 +972,7 @@ impl ContactPair {
                 }
             }
             if let Some(f) = &drive {
-                add(f.dof, f.dof, if share.is_none() { dn.dot(&hn) } else { part * dn.dot(&hn) });
+                add(f.dof, f.dof, part * dn.dot(&hn));
             }
         }
         let Some(add) = add_tangent else { return };
