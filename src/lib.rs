@@ -21,5 +21,6 @@ pub mod assembly;
 pub mod contact;
 pub mod follower;
 pub mod model;
+pub mod linearised_contact;
 pub mod nonlinear;
 pub mod share;

@@ -616,6 +616,35 @@ impl<E: Element> NonlinearProblem for Model<E> {
             u[nd + k] += du[neq + k];
         }
     }
+    /// The nodal contact points of every pair, by equation (the force-driven punch's unknown
+    /// after the plate's); none on several processes (each holds only its own points).
+    fn constraint_rows(&self) -> Vec<crate::linearised_contact::ConstraintRow> {
+        if self.share.is_some() {
+            return Vec::new();
+        }
+        let nd = self.dofs.num_dofs();
+        let neq = self.dofs.num_equations();
+        let mut out = Vec::new();
+        for (pi, pair) in self.contacts.iter().enumerate() {
+            for row in pair.linearised_rows() {
+                let mut coef = Vec::with_capacity(4);
+                for (d, c) in row.dofs.iter().zip(row.grad) {
+                    if *d == usize::MAX || c == 0.0 {
+                        continue;
+                    }
+                    let e = if *d < nd { self.dofs.equation(*d) } else { Some(neq + d - nd) };
+                    if let Some(e) = e {
+                        coef.push((e, c));
+                    }
+                }
+                out.push(crate::linearised_contact::ConstraintRow { coef, weight: row.weight, eps: row.eps, trial: row.trial, active: row.active, id: (pi, row.point) });
+            }
+        }
+        out
+    }
+    fn set_constraint_state(&mut self, id: (usize, usize), active: bool) {
+        self.contacts[id.0].set_linearised_state(id.1, active);
+    }
     fn update_active_set(&mut self) -> usize {
         let mut changes = 0;
         for c in self.contacts.iter_mut() {

@@ -181,6 +181,11 @@ pub struct ContactPair {
     /// and the same 22 back in at each step's update, one Newton iteration each (40 -> 32 Newton
     /// iterations in 5 steps; docs/performance.md).
     hold_after_update: bool,
+    /// The last evaluation with a tangent kept the least tensile point of a set it would have
+    /// emptied (see `evaluate`): the next one may empty it.
+    kept_last: bool,
+    /// Keep the least tensile point of a set an evaluation would empty (default true).
+    pub guard_empty: bool,
     /// The point kinematics of the last evaluation (scratch, reused).
     kinematics_scratch: Vec<Kinematics>,
     /// The integrated discretisation's face ([`ContactFace`]); None: the paper's nodal collocation.
@@ -285,6 +290,20 @@ impl SiteContext<'_> {
     }
 }
 
+/// A contact point's constraint linearised at the last evaluation ([`ContactPair::linearised_rows`]):
+/// the trial multiplier `trial + eps * grad . (du at dofs)`.
+#[derive(Debug, Clone, Copy)]
+pub struct LinearisedRow {
+    pub point: usize,
+    /// The point's three displacement dofs and the force-driven punch's travel (usize::MAX: none).
+    pub dofs: [usize; 4],
+    pub grad: [f64; 4],
+    pub weight: f64,
+    pub eps: f64,
+    pub trial: f64,
+    pub active: bool,
+}
+
 /// The default [`ContactPair::release_fraction`]. A Newton step that puts a band of points onto
 /// the punch's tangent plane leaves most of them just outside a convex punch, barely tensile
 /// beside the few that truly lift off; released together, the plate around them springs back
@@ -380,6 +399,8 @@ impl ContactPair {
             step_start: true,
             predicted_step: false,
             hold_after_update: false,
+            kept_last: false,
+            guard_empty: true,
             kinematics_scratch: Vec::new(),
             face: None,
             site_scratch: Vec::new(),
@@ -529,6 +550,7 @@ impl ContactPair {
         self.flips.fill(0);
         self.frozen.fill(false);
         self.step_start = true;
+        self.kept_last = false;
         // over this process's points: the next evaluation takes the largest over the processes
         self.lambda_scale = self.state.iter().enumerate().filter(|(k, _)| self.owns(*k)).map(|(_, s)| s.lambda.abs()).fold(0.0, f64::max);
         self.converged_scale = self.lambda_scale;
@@ -699,6 +721,30 @@ impl ContactPair {
         let release_cut = if damped && !first && self.release_fraction > 0.0 { self.release_fraction * most } else { 0.0 };
         // at most one point active before this evaluation: a change is a lone point swinging
         let lone = !first && active_before <= 1.0;
+        // An evaluation that would release every point of a set that held some (no active point
+        // still pressed, none penetrating to enter) keeps the least tensile one for one more
+        // iteration, once: a body that the punch alone holds against its load (the paper's strip
+        // around the cylinder) is otherwise left free, its tangent singular, and the step is
+        // cut back; a real lift-off costs one iteration more.
+        let mut least_tensile = f64::INFINITY;
+        if damped && !first && active_before > 0.0 && !self.kept_last && deepest == 0.0 && self.guard_empty {
+            let mut pressed = kin.iter().enumerate().filter(|(k, q)| own(*k) && (self.frozen[*k] || (self.last_active[*k] && trial_of(*k, q) <= 0.0))).count() as f64;
+            let mut least = kin.iter().enumerate().filter(|(k, _)| own(*k) && self.last_active[*k]).map(|(k, q)| trial_of(k, q)).fold(f64::INFINITY, f64::min);
+            if let Some(sh) = share {
+                let mut c = [pressed];
+                sh.reduce.sum(&mut c)?;
+                pressed = c[0];
+                let mut m = [least];
+                sh.reduce.min_f64(&mut m)?;
+                least = m[0];
+            }
+            if pressed == 0.0 {
+                least_tensile = least;
+            }
+        }
+        if with_tangent {
+            self.kept_last = least_tensile.is_finite();
+        }
         // for STAMP_DEBUG: points deferred, released, entering, penetrating, held
         let mut tally = [0usize; 5];
         let integrated = self.face.is_some();
@@ -735,7 +781,7 @@ impl ContactPair {
             let active = if deferred {
                 changes += 1;
                 false
-            } else if with_tangent && (self.hold_after_update || (self.entered[k] && self.hold_after_entry && !self.hold_active_set && (!self.predicted_step || self.entered_deep[k])) || trial < release_cut || converging) && self.last_active[k] && !wanted && !self.frozen[k] {
+            } else if with_tangent && (self.hold_after_update || (self.entered[k] && self.hold_after_entry && !self.hold_active_set && (!self.predicted_step || self.entered_deep[k])) || trial < release_cut || converging || trial == least_tensile) && self.last_active[k] && !wanted && !self.frozen[k] {
                 // right after an augmented-Lagrangian update (hold_after_update), or right after
                 // the point entered: not released yet. A Newton step puts a point that enters onto
                 // the punch's tangent plane at its last position; on a convex punch Psi is positive
@@ -1017,6 +1063,48 @@ impl ContactPair {
                 add(f.dof, f.dof, c * a_s * a_s);
             }
         }
+    }
+
+    /// Each point's constraint linearised at the last evaluation, for the re-solve of the
+    /// linearised contact problem ([`crate::linearised_contact`]): nodal contact only (the
+    /// integrated scheme's rows couple a node's cells), not with the paper's fixed set
+    /// (`hold_active_set`), not the points that cycled (they keep the active side) nor those with
+    /// no gradient.
+    pub fn linearised_rows(&self) -> Vec<LinearisedRow> {
+        if self.face.is_some() || self.hold_active_set {
+            return Vec::new();
+        }
+        let dn = self.drive.map(|f| Vector3::from(f.direction)).unwrap_or_else(Vector3::zeros);
+        let mut out = Vec::new();
+        for (k, (p, s)) in self.points.iter().zip(&self.state).enumerate() {
+            let g = Vector3::from(s.grad);
+            if self.frozen[k] || g.norm() == 0.0 {
+                continue;
+            }
+            // the force-driven punch's travel s moves the point against the punch by -dn
+            let (drive_dof, grad_s) = match &self.drive {
+                Some(f) => (f.dof, -g.dot(&dn)),
+                None => (usize::MAX, 0.0),
+            };
+            out.push(LinearisedRow {
+                point: k,
+                dofs: [p.dofs[0], p.dofs[1], p.dofs[2], drive_dof],
+                grad: [g[0], g[1], g[2], grad_s],
+                weight: p.weight,
+                eps: self.eps_reg,
+                trial: self.lambda_bar[k] + self.eps_reg * s.psi,
+                active: s.active,
+            });
+        }
+        out
+    }
+
+    /// The state the re-solve found for point k, for the next evaluation: an entering point is
+    /// held one iteration as every entering point is.
+    pub fn set_linearised_state(&mut self, k: usize, active: bool) {
+        self.last_active[k] = active;
+        self.entered[k] = active;
+        self.entered_deep[k] = false;
     }
 
     /// The paper's active-set update (eqs. 4.14b, 4.15a) after Newton converged on a fixed set: add

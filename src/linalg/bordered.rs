@@ -237,6 +237,53 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         Ok(())
     }
 
+    /// The leading block's columns by the inner solver's `solve_many_approx`, then the border
+    /// as in `solve_in_place_to`.
+    fn solve_many_approx(&mut self, b: &mut [f64], ncols: usize) -> Result<()> {
+        if self.border == 0 {
+            return self.inner.solve_many_approx(b, ncols);
+        }
+        if ncols == 0 {
+            return Ok(());
+        }
+        let (n0, m) = (self.n0, self.border);
+        let n = n0 + m;
+        let mut lead = vec![0.0; n0 * ncols];
+        for (l, c) in lead.chunks_mut(n0).zip(b.chunks(n)) {
+            l.copy_from_slice(&c[..n0]);
+        }
+        self.inner.solve_many_approx(&mut lead, ncols)?;
+        let Some(schur) = self.schur.as_ref() else {
+            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
+        };
+        for (z, c) in lead.chunks(n0).zip(b.chunks_mut(n)) {
+            let (b1, b2) = c.split_at_mut(n0);
+            let mut r = nalgebra::DVector::<f64>::zeros(m);
+            for k in 0..m {
+                let row = &self.a21_dense[k * n0..(k + 1) * n0];
+                r[k] = b2[k] - row.iter().zip(z).map(|(a, z)| a * z).sum::<f64>();
+            }
+            let x2 = schur.solve(&r).ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
+            b1.copy_from_slice(z);
+            for k in 0..m {
+                b2[k] = x2[k];
+                let col = &self.y[k * n0..(k + 1) * n0];
+                for (x, yv) in b1.iter_mut().zip(col) {
+                    *x -= yv * x2[k];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Without a border, the inner solver's; with one, None (whole columns instead).
+    fn forward_columns(&mut self, b: &[Vec<(usize, f64)>]) -> Result<Option<Vec<crate::linalg::supernodal_solve::ForwardColumn>>> {
+        if self.border == 0 {
+            return self.inner.forward_columns(b);
+        }
+        Ok(None)
+    }
+
     fn timings(&self) -> SolverTimings {
         self.inner.timings()
     }

@@ -82,7 +82,7 @@ use crate::error::{Result, StampError};
 use crate::linalg::gmres::{Gmres, GmresReport};
 use crate::linalg::linear_solver::{parallelism_for, LinearSolver, SolverTimings, SparseLu};
 use crate::linalg::ordering;
-use crate::linalg::supernodal_solve::SupernodalSolve;
+use crate::linalg::supernodal_solve::{ForwardColumn, SparseForward, SupernodalSolve};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering};
@@ -155,6 +155,8 @@ pub struct LdltGmres {
     /// The tree-parallel solve with a supernodal factor of `symbolic` (None: simplicial, faer's
     /// solve), used unless the parallelism is sequential.
     supernodal: Option<SupernodalSolve>,
+    /// The sparse forward solves of `forward_columns`, built at its first call for a pattern.
+    sparse_forward: Option<SparseForward>,
     /// The ordering asked for, and the one the current symbolic factor uses (Amd or
     /// NestedDissection).
     ordering: Ordering,
@@ -217,6 +219,7 @@ impl LdltGmres {
         LdltGmres {
             symbolic: None,
             supernodal: None,
+            sparse_forward: None,
             ordering: Ordering::default(),
             ordering_used: None,
             factor: Vec::new(),
@@ -329,6 +332,7 @@ impl LdltGmres {
         self.row_values = if self.transpose.is_some() { vec![0.0; nnz] } else { Vec::new() };
         self.symbolic = None;
         self.supernodal = None;
+        self.sparse_forward = None;
         self.ordering_used = None;
         self.factor_valid = false;
         if self.transpose.is_some() {
@@ -713,6 +717,9 @@ fn transpose_positions(col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize
     crate::linalg::sparse::pair_transposed(col_ptr, row_idx, |k, partner| out[k] = partner).then_some(out)
 }
 
+/// Columns solved together by [`LdltGmres`]'s `solve_many_approx`.
+const MANY_BLOCK: usize = 32;
+
 impl LinearSolver for LdltGmres {
     fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
         self.factorize_preconditioned(a, None)
@@ -881,6 +888,58 @@ impl LinearSolver for LdltGmres {
             return self.lu.as_mut().unwrap().solve_in_place(b);
         }
         Ok(())
+    }
+
+    /// The LDL^T factor (of A when it is symmetric, of its preconditioner otherwise) applied to
+    /// all the columns at once, in blocks of [`MANY_BLOCK`] (a block of columns reads the factor
+    /// once); the LU where that took over.
+    fn solve_many_approx(&mut self, b: &mut [f64], ncols: usize) -> Result<()> {
+        if ncols == 0 {
+            return Ok(());
+        }
+        if !self.factored {
+            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
+        }
+        let n = b.len() / ncols;
+        if self.mode == Mode::Lu {
+            for col in b.chunks_mut(n) {
+                self.lu.as_mut().unwrap().solve_in_place(col)?;
+            }
+            return Ok(());
+        }
+        let t = Instant::now();
+        let sym = self.symbolic.as_ref().unwrap();
+        let par = parallelism_for(n, self.par);
+        let block = ncols.min(MANY_BLOCK);
+        let scratch = sym.solve_in_place_scratch::<f64>(block, par);
+        let mut buffer = MemBuffer::try_new(scratch).map_err(|_| StampError::LinearSolver("out of memory for the LDL^T solve's workspace".into()))?;
+        for cols in b.chunks_mut(n * block) {
+            let k = cols.len() / n;
+            LdltRef::new(sym, &self.factor).solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(cols, n, k), par, MemStack::new(&mut buffer));
+        }
+        crate::linalg::vector_state::clean_upper_vector_state();
+        self.timings.solve += t.elapsed().as_secs_f64();
+        if b.iter().any(|x| !x.is_finite()) {
+            return Err(StampError::LinearSolver("the solution has non-finite entries: the matrix is singular".into()));
+        }
+        Ok(())
+    }
+
+    /// With a supernodal factor large enough for the parallel solve (below that a whole solve is
+    /// cheap); the factor of A when it is symmetric, of its preconditioner otherwise.
+    fn forward_columns(&mut self, b: &[Vec<(usize, f64)>]) -> Result<Option<Vec<ForwardColumn>>> {
+        if !self.factored || self.mode == Mode::Lu || self.supernodal.is_none() {
+            return Ok(None);
+        }
+        let t = Instant::now();
+        let sym = self.symbolic.as_ref().unwrap();
+        if self.sparse_forward.is_none() {
+            self.sparse_forward = SparseForward::new(sym);
+        }
+        let Some(forward) = self.sparse_forward.as_mut() else { return Ok(None) };
+        let columns = b.iter().map(|g| forward.column(sym, &self.factor, g)).collect();
+        self.timings.solve += t.elapsed().as_secs_f64();
+        Ok(Some(columns))
     }
 
     fn timings(&self) -> SolverTimings {

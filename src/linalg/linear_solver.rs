@@ -3,6 +3,7 @@
 //! computed once for the pattern and reused by every numeric factorisation; so is the memory of the
 //! numeric factors.
 
+use crate::linalg::supernodal_solve::ForwardColumn;
 use crate::error::{Result, StampError};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu};
@@ -53,6 +54,30 @@ pub trait LinearSolver: Send {
     fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
         let _ = rtol;
         self.solve_in_place(b)
+    }
+    /// Solve A X = B in place for the `ncols` columns of `b` (column-major, each of A's size)
+    /// with the last factorisation, to a preconditioner's accuracy: an iterative solver may apply
+    /// its preconditioner alone, once for all the columns. For estimates (the contact points'
+    /// compliance, [`crate::nonlinear`]); the default solves each column as
+    /// [`LinearSolver::solve_in_place`] does.
+    fn solve_many_approx(&mut self, b: &mut [f64], ncols: usize) -> Result<()> {
+        if ncols == 0 {
+            return Ok(());
+        }
+        let n = b.len() / ncols;
+        for col in b.chunks_mut(n) {
+            self.solve_in_place(col)?;
+        }
+        Ok(())
+    }
+    /// The forward halves of sparse right-hand sides (pairs of an index and a value) with a
+    /// symmetric factor of the last matrix, to a preconditioner's accuracy: two of them give
+    /// b^T A^-1 c ([`ForwardColumn::dot`]) at the cost of the factor's rows on their paths to
+    /// the root. None where the solver has no such factor or it would not pay (the caller
+    /// then solves whole columns, [`LinearSolver::solve_many_approx`]); the default.
+    fn forward_columns(&mut self, b: &[Vec<(usize, f64)>]) -> Result<Option<Vec<ForwardColumn>>> {
+        let _ = b;
+        Ok(None)
     }
     /// Time spent so far.
     fn timings(&self) -> SolverTimings;

@@ -960,6 +960,48 @@ mod tests {
         }
     }
 
+    /// b^T A^-1 c from the forward columns of sparse b and c equals the same from a whole solve,
+    /// for vectors of one unknown and of several nodes apart, on definite and indefinite factors,
+    /// AMD and nested dissection; the scratch is clean after each column.
+    #[test]
+    fn forward_columns_give_the_compliance_of_a_whole_solve() {
+        for (k, dofs, indefinite, nested) in [(40, 3, false, false), (40, 3, true, true), (30, 6, false, true)] {
+            let a = grid(k, dofs, indefinite, 11 + k as u64);
+            let n = a.nrows();
+            let (sym, factor) = factorise(&a, nested);
+            let mut forward = SparseForward::new(&sym).expect("a supernodal factor");
+            let mut rng = Random(5);
+            // sparse vectors: a node's unknowns with random weights, at spread nodes, one of them
+            // of a single unknown and one over two nodes
+            let mut vectors: Vec<Vec<(usize, f64)>> = (0..6)
+                .map(|i| {
+                    let node = (i * 7919 + 13) % (k * k);
+                    (0..dofs).map(|p| (node * dofs + p, rng.next())).collect()
+                })
+                .collect();
+            vectors.push(vec![(n / 2, 1.0)]);
+            vectors.push(vec![(3, 0.5), (n - 2, -1.5)]);
+            let columns: Vec<ForwardColumn> = vectors.iter().map(|b| forward.column(&sym, &factor, b)).collect();
+            assert!(forward.work.iter().all(|&x| x == 0.0), "the scratch is left clean");
+            let dense = |b: &[(usize, f64)]| {
+                let mut v = vec![0.0; n];
+                b.iter().for_each(|&(i, x)| v[i] += x);
+                v
+            };
+            for (i, bi) in vectors.iter().enumerate() {
+                let x = faer_solve(&sym, &factor, &dense(bi));
+                for (j, bj) in vectors.iter().enumerate() {
+                    let expected: f64 = bj.iter().map(|&(e, c)| c * x[e]).sum();
+                    let got = columns[j].dot(&columns[i]);
+                    assert!((got - expected).abs() <= 1e-11 * expected.abs().max(1.0), "{k} x {k} x {dofs} ({indefinite}, {nested}): b{j}^T A^-1 b{i} = {got} against {expected}");
+                }
+            }
+            // a path is much shorter than the factor: only the ancestors' rows are computed
+            let longest = columns.iter().map(|c| c.y.len()).max().unwrap();
+            assert!(longest < n / 4, "{longest} of {n} rows on a path");
+        }
+    }
+
     #[test]
     fn a_simplicial_factor_falls_back_to_faer() {
         let mut t = Vec::new();
@@ -982,5 +1024,115 @@ mod tests {
             solver.solve_in_place(&sym, &factor, &mut x, parallel);
             assert_eq!(x, expected);
         }
+    }
+}
+
+/// The forward half y = L^-1 Pi b of a solve with a supernodal factor A = Pi^T L D L^T Pi, for a
+/// sparse b: y is zero outside the supernodes on the paths from b's supernodes to the root, and
+/// only those are computed (a few separators of the nested dissection instead of the whole
+/// factor). Two such columns give b^T A^-1 c = y_b^T D^-1 y_c ([`ForwardColumn::dot`]): the
+/// compliance between contact points without a whole solve per point.
+pub struct ForwardColumn {
+    /// The supernodes of the path, increasing.
+    nodes: Vec<u32>,
+    /// Where each node's segment starts in `y` (one past the last: `y.len()`).
+    start: Vec<u32>,
+    /// y on the path's columns, and y / d.
+    y: Vec<f64>,
+    yd: Vec<f64>,
+}
+
+impl ForwardColumn {
+    /// b^T A^-1 c for the vectors b and c of `self` and `other` (A symmetric): the sum over
+    /// the supernodes both paths hold (the common ancestors).
+    pub fn dot(&self, other: &ForwardColumn) -> f64 {
+        let (mut i, mut j, mut sum) = (0, 0, 0.0);
+        while i < self.nodes.len() && j < other.nodes.len() {
+            match self.nodes[i].cmp(&other.nodes[j]) {
+                std::cmp::Ordering::Less => i += 1,
+                std::cmp::Ordering::Greater => j += 1,
+                std::cmp::Ordering::Equal => {
+                    let a = &self.y[self.start[i] as usize..self.segment_end(i)];
+                    let b = &other.yd[other.start[j] as usize..other.segment_end(j)];
+                    sum += a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+                    i += 1;
+                    j += 1;
+                }
+            }
+        }
+        sum
+    }
+
+    fn segment_end(&self, i: usize) -> usize {
+        self.start.get(i + 1).map_or(self.y.len(), |&s| s as usize)
+    }
+}
+
+/// Computes [`ForwardColumn`]s with the factors of one symbolic supernodal LDL^T.
+pub struct SparseForward {
+    /// The supernode of every (permuted) column.
+    of: Vec<u32>,
+    /// The parent of every supernode (u32::MAX: a root).
+    parent: Vec<u32>,
+    /// Dense scratch of the matrix's size, zero between calls.
+    work: Vec<f64>,
+    y: Vec<f64>,
+}
+
+impl SparseForward {
+    /// None for a simplicial factor.
+    pub fn new(symbolic: &SymbolicCholesky<usize>) -> Option<Self> {
+        let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { return None };
+        let (n, ns) = (symbolic.nrows(), sn.n_supernodes());
+        let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
+        let mut of = vec![0u32; n];
+        for s in 0..ns {
+            of[begin[s]..end[s]].iter_mut().for_each(|v| *v = s as u32);
+        }
+        let rp = sn.col_ptr_for_row_idx();
+        let ri = sn.row_idx();
+        let parent = (0..ns).map(|s| ri[rp[s]..rp[s + 1]].first().map_or(u32::MAX, |&i| of[i])).collect();
+        let max_rows = (0..ns).map(|s| end[s] - begin[s] + rp[s + 1] - rp[s]).max().unwrap_or(0);
+        Some(SparseForward { of, parent, work: vec![0.0; n], y: vec![0.0; max_rows] })
+    }
+
+    /// The forward column of b (pairs of an unpermuted index and a value) with the factor
+    /// `factor` of `symbolic`.
+    pub fn column(&mut self, symbolic: &SymbolicCholesky<usize>, factor: &[f64], b: &[(usize, f64)]) -> ForwardColumn {
+        let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { unreachable!("SparseForward is built for supernodal factors only") };
+        let inv = symbolic.perm().map(|p| p.arrays().1);
+        let mut nodes: Vec<u32> = Vec::new();
+        for &(e, v) in b {
+            let p = inv.map_or(e, |inv| inv[e]);
+            self.work[p] += v;
+            let mut s = self.of[p];
+            // the path to the root, until it meets one already taken
+            while s != u32::MAX && !nodes.contains(&s) {
+                nodes.push(s);
+                s = self.parent[s as usize];
+            }
+        }
+        nodes.sort_unstable();
+        let mut start = Vec::with_capacity(nodes.len());
+        let mut y = Vec::new();
+        let mut yd = Vec::new();
+        for &s in &nodes {
+            let (begin, w, pattern, l) = supernode(sn, factor, s as usize);
+            let ld = w + pattern.len();
+            let t = &mut self.y[..ld];
+            t[..w].copy_from_slice(&self.work[begin..begin + w]);
+            t[w..].fill(0.0);
+            lower_solve(l, ld, w, t);
+            for (&i, v) in pattern.iter().zip(&t[w..]) {
+                self.work[i] += v;
+            }
+            start.push(y.len() as u32);
+            for j in 0..w {
+                y.push(t[j]);
+                yd.push(t[j] * l[j * ld + j].recip());
+            }
+            self.work[begin..begin + w].fill(0.0);
+        }
+        ForwardColumn { nodes, start, y, yd }
     }
 }
