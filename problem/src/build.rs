@@ -545,6 +545,9 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
     if let Some(x) = sv.cycling_after {
         settings.cycling_after = x.0;
     }
+    if let Some(x) = sv.resolve_contact {
+        settings.resolve_contact = x;
+    }
     settings.validate().map_err(|e| StampError::Input { file: p.path.display().to_string(), message: format!("[solver]: {e}") })?;
     Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, coarse: None })
 }

@@ -872,6 +872,10 @@ pub struct SolverSpec {
     /// iteration on, and cut it back (off by default; see NewtonSettings::cycling_after).
     #[serde(default)]
     pub cycling_after: Option<CycleCount>,
+    /// Solve the linearised contact problem again on each factorisation (default true; see
+    /// NewtonSettings::resolve_contact).
+    #[serde(default)]
+    pub resolve_contact: Option<bool>,
     /// Where each load step starts (default "secant").
     #[serde(default)]
     pub predictor: Option<Spanned<Predictor>>,

@@ -250,3 +250,29 @@ fn a_tension_that_falls_tenfold_at_each_iteration_is_held_and_one_that_does_not_
     evaluate(&mut r, lift(0.02));
     assert_eq!(evaluate(&mut r, lift(0.001)), (1, vec![false, true, false, true]));
 }
+
+#[test]
+fn a_set_is_not_emptied_in_one_evaluation() {
+    // all four points in contact, then all lift off (trials 10, 8, 6 and 5), none penetrating:
+    // the least tensile one stays for one more evaluation (a change), then leaves too
+    let mut p = pair(0.5);
+    assert!(p.guard_empty);
+    evaluate(&mut p, [1e-3; 4]);
+    assert_eq!(evaluate(&mut p, [1e-3; 4]), (0, vec![true; 4]), "settled in contact");
+    let lifted = [-1.0 + 1e-3, -0.8 + 1e-3, -0.6 + 1e-3, -0.5 + 1e-3];
+    assert_eq!(evaluate(&mut p, lifted), (4, vec![false, false, false, true]));
+    assert!((p.state[3].lambda - 5.0).abs() < 1e-12, "held with its exact trial multiplier");
+    assert_eq!(evaluate(&mut p, lifted), (1, vec![false; 4]), "then released: a real lift-off");
+    assert_eq!(evaluate(&mut p, lifted).0, 0);
+    // a set that keeps a pressed point is released as the rules say
+    let mut q = pair(0.5);
+    evaluate(&mut q, [1e-3; 4]);
+    evaluate(&mut q, [1e-3; 4]);
+    assert_eq!(evaluate(&mut q, [-1.0 + 1e-3, -0.8 + 1e-3, -0.6 + 1e-3, 2e-3]), (3, vec![false, false, false, true]));
+    // guard_empty = false: every point leaves at once
+    let mut r = pair(0.5);
+    r.guard_empty = false;
+    evaluate(&mut r, [1e-3; 4]);
+    evaluate(&mut r, [1e-3; 4]);
+    assert_eq!(evaluate(&mut r, lifted), (4, vec![false; 4]));
+}

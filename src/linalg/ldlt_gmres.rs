@@ -1223,6 +1223,49 @@ mod tests {
         }
     }
 
+    /// The estimates for the linearised contact re-solve: many columns at once give what one
+    /// solve each gives (the factor of A when symmetric, of S otherwise: there within GMRES's
+    /// distance of A^-1 b); the forward halves of sparse vectors give b^T A^-1 c of a whole solve
+    /// with a supernodal factor, and none with a simplicial one.
+    #[test]
+    fn many_columns_and_forward_halves_agree_with_single_solves() {
+        for (k, skew) in [(150, 0.0), (150, 0.05), (12, 0.0)] {
+            let a = grid(k, skew);
+            let n = a.nrows();
+            let mut solver = LdltGmres::new();
+            solver.factorize(a.as_ref()).unwrap();
+            let columns: Vec<Vec<f64>> = (0..3).map(|c| (0..n).map(|i| ((i * (c + 2)) as f64 * 0.37).sin()).collect()).collect();
+            let mut many: Vec<f64> = columns.concat();
+            solver.solve_many_approx(&mut many, 3).unwrap();
+            for (c, col) in columns.iter().enumerate() {
+                let mut one = col.clone();
+                solver.solve_in_place(&mut one).unwrap();
+                let scale = one.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let err = many[c * n..(c + 1) * n].iter().zip(&one).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale;
+                let allowed = if skew == 0.0 { 1e-10 } else { 0.2 };
+                assert!(err < allowed, "k = {k}, skew {skew}, column {c}: {err:e}");
+            }
+            let sparse: Vec<Vec<(usize, f64)>> = vec![vec![(n / 2, 1.0), (n / 2 + 1, -0.5)], vec![(7, 2.0)], vec![(n - 3, 1.0), (n / 3, 0.25)]];
+            match solver.forward_columns(&sparse).unwrap() {
+                Some(fc) => {
+                    assert_eq!(k, 150, "forward halves from a simplicial factor");
+                    for (i, bi) in sparse.iter().enumerate() {
+                        let mut x = vec![0.0; n];
+                        bi.iter().for_each(|&(e, v)| x[e] += v);
+                        // the same factor (of A or S) applied whole
+                        solver.solve_many_approx(&mut x, 1).unwrap();
+                        for (j, bj) in sparse.iter().enumerate() {
+                            let expected: f64 = bj.iter().map(|&(e, c)| c * x[e]).sum();
+                            let got = fc[j].dot(&fc[i]);
+                            assert!((got - expected).abs() <= 1e-12 * expected.abs().max(1e-3), "k = {k}, skew {skew}: {got} against {expected}");
+                        }
+                    }
+                }
+                None => assert!(k == 12, "no forward halves from the supernodal factor of {n} unknowns"),
+            }
+        }
+    }
+
     /// With a parallel setting the first factorisation of a pattern runs on the threads, the
     /// second on one, the later ones the faster way; a sequential solver never tries the threads;
     /// a new pattern measures again.
