@@ -19,7 +19,7 @@
 //! preconditioner of an unsymmetric tangent), an estimate that only chooses the set. Each round
 //! costs one solve with the factor (the trials of every point); the step is corrected with one
 //! accurate solve. The set found is handed to the problem for its next evaluation
-//! ([`NonlinearProblem::set_constraint_state`]), where the usual rules apply to it.
+//! ([`crate::nonlinear::NonlinearProblem::set_constraint_state`]), where the usual rules apply to it.
 //!
 //! Rounds enter the deepest [`ROUND_ENTRY_FRACTION`] of the penetrating points and at most as
 //! many as are in the set ([`ROUND_ENTRY_MIN`] at least): a first contact's linearised overlap

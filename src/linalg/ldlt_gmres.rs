@@ -891,7 +891,7 @@ impl LinearSolver for LdltGmres {
     }
 
     /// The LDL^T factor (of A when it is symmetric, of its preconditioner otherwise) applied to
-    /// all the columns at once, in blocks of [`MANY_BLOCK`] (a block of columns reads the factor
+    /// all the columns at once, in blocks of `MANY_BLOCK` (32) (a block of columns reads the factor
     /// once); the LU where that took over.
     fn solve_many_approx(&mut self, b: &mut [f64], ncols: usize) -> Result<()> {
         if ncols == 0 {
