@@ -152,7 +152,7 @@ pub struct NewtonSettings {
     /// rows (nodal contact on one process). Measured on the shipped problems, the README
     /// tutorial, the torus die and a cylinder on triangles (docs/performance.md): the torus on
     /// triangles of size 1 43 -> 25 Newton iterations in 4 steps, paper-r100 75 in 9 steps -> 50
-    /// in 8, the cylinder on triangles of size 1 28 -> 13 (37 -> 17 s). False: one guess of the
+    /// in 8, the cylinder on triangles of size 1 28 -> 13 (37 -> 18 s). False: one guess of the
     /// set per factorisation.
     pub resolve_contact: bool,
     /// Largest forcing term of the inexact Newton method: the linear solve of an iteration may
