@@ -25,8 +25,8 @@
 //! many as are in the set ([`ROUND_ENTRY_MIN`] at least): a first contact's linearised overlap
 //! is wide (the set would swing out and back in the next rounds, a column each); a point whose
 //! trial is tensile at the iterate itself (held by the evaluation's rules) is not released here.
-//! A cycling set, [`MAX_ROUNDS`] rounds without settling, or a singular system leave the step as
-//! it was.
+//! A cycling set, [`MAX_ROUNDS`] rounds without settling, more than [`MAX_COLUMNS`] points
+//! changing, or a singular system leave the step as it was.
 
 use crate::error::Result;
 use crate::linalg::linear_solver::LinearSolver;
@@ -38,6 +38,16 @@ use std::collections::HashSet;
 /// problems and the torus die: settled sets take 1 to 8 rounds; 20 rounds cost torus on triangles
 /// of size 1 21 s in sets that never settled.
 pub const MAX_ROUNDS: usize = 10;
+
+/// The most points that may change state in one re-solve (each a forward column of the factor,
+/// their compliance and a capacitance system of their size solved every round): past it the step
+/// is left as it was. Sets that settle took up to 341 (the torus die on triangles of size 1);
+/// sets that never settle took thousands: unbounded, the force-driven sphere of
+/// meshes/sphere-ss.toml on 100 x 100 cells took 95 s (34 Newton iterations) against 20.8 s (35)
+/// at 512 and 17.6 s (40) at 256 and 19.6 s (80) without the re-solve; `stamp bench --problem
+/// sphere-displacement` at n = 80 12.9 s against 4.6 s at 512 and 5.6 s without; 256 cost the
+/// torus of size 1 five iterations more.
+pub const MAX_COLUMNS: usize = 512;
 
 /// A round enters the penetrating points whose linearised trial is at most this fraction of the
 /// deepest one's.
@@ -132,6 +142,9 @@ pub fn resolve<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
             on[k] = !on[k];
         }
         let new: Vec<usize> = changing.into_iter().filter(|&k| slot[k] == usize::MAX).collect();
+        if changed_rows.len() + new.len() > MAX_COLUMNS {
+            break false;
+        }
         if !new.is_empty() {
             add_columns(linear, rows, &new, &mut changed_rows, &mut slot, &mut compliance, &mut forward, n)?;
             report.columns += new.len();

@@ -46,6 +46,10 @@ pub struct BorderedSolver<S: LinearSolver = LdltGmres> {
     /// A21 as a dense m x n0 matrix (row-major) of the last factorisation.
     a21_dense: Vec<f64>,
     schur: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// For `forward_columns`, built at its first call after a factorisation: A11^-1 A21^T
+    /// (column-major n0 x m, by the inner solver's estimate) and S^-1.
+    z: Vec<f64>,
+    schur_inverse: Option<std::sync::Arc<nalgebra::DMatrix<f64>>>,
 }
 
 impl BorderedSolver<LdltGmres> {
@@ -73,6 +77,8 @@ impl<S: LinearSolver> BorderedSolver<S> {
             y: Vec::new(),
             a21_dense: Vec::new(),
             schur: None,
+            z: Vec::new(),
+            schur_inverse: None,
         }
     }
 
@@ -166,6 +172,8 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
             Some(_) => return Err(StampError::LinearSolver("the preconditioner's pattern is not the matrix's".into())),
             None => self.inner.factorize(a11)?,
         }
+        self.z.clear();
+        self.schur_inverse = None;
         // Y = A11^-1 A12
         self.y.clear();
         self.y.resize(n0 * m, 0.0);
@@ -276,12 +284,48 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         Ok(())
     }
 
-    /// Without a border, the inner solver's; with one, None (whole columns instead).
+    /// With a border: the inner solver's forward columns of the vectors' leading parts, with the
+    /// border's terms of b^T K^-1 c = b1^T A11^-1 c1 + (b1 . Y - b2)^T S^-1 (A21 A11^-1 c1 - c2)
+    /// (the block inverse; A11^-1 the inner solver's symmetric estimate, Y = A11^-1 A12 as
+    /// factorised).
     fn forward_columns(&mut self, b: &[Vec<(usize, f64)>]) -> Result<Option<Vec<crate::linalg::supernodal_solve::ForwardColumn>>> {
         if self.border == 0 {
             return self.inner.forward_columns(b);
         }
-        Ok(None)
+        let (n0, m) = (self.n0, self.border);
+        let lead: Vec<Vec<(usize, f64)>> = b.iter().map(|g| g.iter().copied().filter(|&(e, _)| e < n0).collect()).collect();
+        let Some(columns) = self.inner.forward_columns(&lead)? else { return Ok(None) };
+        let Some(schur) = self.schur.as_ref() else {
+            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
+        };
+        if self.schur_inverse.is_none() {
+            let inverse = schur.clone().try_inverse().ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
+            self.schur_inverse = Some(std::sync::Arc::new(inverse));
+            self.z = self.a21_dense.clone();
+            self.inner.solve_many_approx(&mut self.z, m)?;
+        }
+        let inverse = self.schur_inverse.clone().expect("built above");
+        let out = columns
+            .into_iter()
+            .zip(b)
+            .map(|(column, g)| {
+                let mut left = vec![0.0; m];
+                let mut right = vec![0.0; m];
+                for &(e, x) in g {
+                    if e < n0 {
+                        for k in 0..m {
+                            left[k] += x * self.y[k * n0 + e];
+                            right[k] += x * self.z[k * n0 + e];
+                        }
+                    } else {
+                        left[e - n0] -= x;
+                        right[e - n0] -= x;
+                    }
+                }
+                column.with_border(left, right, inverse.clone())
+            })
+            .collect();
+        Ok(Some(out))
     }
 
     fn timings(&self) -> SolverTimings {

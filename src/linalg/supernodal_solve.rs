@@ -1040,13 +1040,20 @@ pub struct ForwardColumn {
     /// y on the path's columns, and y / d.
     y: Vec<f64>,
     yd: Vec<f64>,
+    /// A bordered matrix's terms (`BorderedSolver`): b's (b1 . Y - b2) and (A21 A11^-1 b1 - b2),
+    /// and S^-1, so that b^T K^-1 c = y_b^T D^-1 y_c + left_b^T S^-1 right_c.
+    border: Option<(Vec<f64>, Vec<f64>, std::sync::Arc<nalgebra::DMatrix<f64>>)>,
 }
 
 impl ForwardColumn {
     /// b^T A^-1 c for the vectors b and c of `self` and `other` (A symmetric): the sum over
     /// the supernodes both paths hold (the common ancestors).
     pub fn dot(&self, other: &ForwardColumn) -> f64 {
-        let (mut i, mut j, mut sum) = (0, 0, 0.0);
+        let mut sum = match (&self.border, &other.border) {
+            (Some((left, _, inverse)), Some((_, right, _))) => (0..left.len()).map(|k| left[k] * (0..right.len()).map(|l| inverse[(k, l)] * right[l]).sum::<f64>()).sum(),
+            _ => 0.0,
+        };
+        let (mut i, mut j) = (0, 0);
         while i < self.nodes.len() && j < other.nodes.len() {
             match self.nodes[i].cmp(&other.nodes[j]) {
                 std::cmp::Ordering::Less => i += 1,
@@ -1061,6 +1068,13 @@ impl ForwardColumn {
             }
         }
         sum
+    }
+
+    /// The column of a bordered matrix's vector: its leading part's forward column with the
+    /// border's terms (see `border`).
+    pub fn with_border(mut self, left: Vec<f64>, right: Vec<f64>, inverse: std::sync::Arc<nalgebra::DMatrix<f64>>) -> Self {
+        self.border = Some((left, right, inverse));
+        self
     }
 
     fn segment_end(&self, i: usize) -> usize {
@@ -1133,6 +1147,6 @@ impl SparseForward {
             }
             self.work[begin..begin + w].fill(0.0);
         }
-        ForwardColumn { nodes, start, y, yd }
+        ForwardColumn { nodes, start, y, yd, border: None }
     }
 }
