@@ -8,9 +8,13 @@ pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-/// A fresh, empty temporary folder unique to this test process and `name`.
+/// A fresh, empty temporary folder unique to this call: the process, a count of the calls, and
+/// `name` (two tests running at once with the same name each get their own: the laminate's probe
+/// runs of two tests once wrote into one folder and one test read the other's half-written run).
 pub fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("stamp-test-{}-{name}", std::process::id()));
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let d = std::env::temp_dir().join(format!("stamp-test-{}-{call}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
