@@ -89,9 +89,8 @@ pub struct Resolve {
 pub fn resolve<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow], du: &mut [f64], report: &mut Resolve) -> Result<Vec<((usize, usize), bool)>> {
     *report = Resolve::default();
     let n = du.len();
-    let dot = |r: &ConstraintRow, v: &[f64]| r.coef.iter().map(|&(e, c)| c * v[e]).sum::<f64>();
     // the gaps' changes under the plain step, and under the corrected one
-    let g0: Vec<f64> = rows.iter().map(|r| dot(r, du)).collect();
+    let g0: Vec<f64> = rows.iter().map(|r| row_dot(r, du)).collect();
     let mut v = g0.clone();
     let mut on: Vec<bool> = rows.iter().map(|r| r.active).collect();
     // the rows that changed state in some round, and the compliance between them
@@ -181,7 +180,7 @@ pub fn resolve<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
         scatter(rows, &changed_rows, &coef, &mut b);
         linear.solve_many_approx(&mut b, 1)?;
         for (k, vk) in v.iter_mut().enumerate() {
-            *vk = g0[k] - dot(&rows[k], &b);
+            *vk = g0[k] - row_dot(&rows[k], &b);
         }
     };
     if !report.settled {
@@ -199,6 +198,11 @@ pub fn resolve<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
     let out: Vec<((usize, usize), bool)> = rows.iter().zip(&on).filter(|(r, o)| r.active != **o).map(|(r, o)| (r.id, *o)).collect();
     report.changed = out.len();
     Ok(out)
+}
+
+/// g . v for the row's gradient g.
+fn row_dot(r: &ConstraintRow, v: &[f64]) -> f64 {
+    r.coef.iter().map(|&(e, c)| c * v[e]).sum()
 }
 
 /// b = sum_j c_j g_j.
@@ -249,7 +253,7 @@ fn add_columns<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
             linear.solve_many_approx(&mut cols, m)?;
             for (c, j) in (base..total).enumerate() {
                 let z = &cols[c * n..(c + 1) * n];
-                let col: Vec<f64> = changed_rows.iter().map(|&k| rows[k].coef.iter().map(|&(e, g)| g * z[e]).sum::<f64>()).collect();
+                let col: Vec<f64> = changed_rows.iter().map(|&k| row_dot(&rows[k], z)).collect();
                 for i in 0..base {
                     compliance[i][j] = col[i];
                 }

@@ -390,6 +390,13 @@ impl<E: Element> Model<E> {
     }
 }
 
+/// The equation of dof `d`: a nodal dof's (None where it is prescribed), or a force-driven
+/// punch's unknown (dofs from `dofs.num_dofs()` on) after the nodal equations.
+fn equation_of(dofs: &DofMap, d: usize) -> Option<usize> {
+    let nd = dofs.num_dofs();
+    if d < nd { dofs.equation(d) } else { Some(dofs.num_equations() + d - nd) }
+}
+
 /// Whether this process adds the tangent entry (row dof r, column dof c) of a contact or
 /// displacement-dependent load (all of them without a share): those of the rows of its own nodes,
 /// of a force-driven punch's row (dofs from `nd` on) those of the columns of its own nodes, and
@@ -473,7 +480,7 @@ impl<E: Element> NonlinearProblem for Model<E> {
             let values = &mut self.values;
             let preconditioner = &mut self.preconditioner;
             let force = if shared { &mut self.contact_force } else { &mut self.force };
-            let eq = |d: usize| if d < nd { dofs.equation(d) } else { Some(neq + d - nd) };
+            let eq = |d: usize| equation_of(dofs, d);
             let mine = owns_row(&self.share, dofs.dofs_per_node(), nd);
             // the contact stiffness is symmetric: it belongs to the preconditioner as it is
             let mut add = |r: usize, c: usize, v: f64| {
@@ -616,28 +623,18 @@ impl<E: Element> NonlinearProblem for Model<E> {
             u[nd + k] += du[neq + k];
         }
     }
-    /// The nodal contact points of every pair, by equation (the force-driven punch's unknown
-    /// after the plate's); none on several processes (each holds only its own points).
+    /// The contact points of every pair, their coefficients renumbered from dofs to equations
+    /// (a prescribed dof's dropped); none on several processes (each holds only its own points).
     fn constraint_rows(&self) -> Vec<crate::linearised_contact::ConstraintRow> {
         if self.share.is_some() {
             return Vec::new();
         }
-        let nd = self.dofs.num_dofs();
-        let neq = self.dofs.num_equations();
         let mut out = Vec::new();
         for (pi, pair) in self.contacts.iter().enumerate() {
-            for row in pair.linearised_rows() {
-                let mut coef = Vec::with_capacity(4);
-                for (d, c) in row.dofs.iter().zip(row.grad) {
-                    if *d == usize::MAX || c == 0.0 {
-                        continue;
-                    }
-                    let e = if *d < nd { self.dofs.equation(*d) } else { Some(neq + d - nd) };
-                    if let Some(e) = e {
-                        coef.push((e, c));
-                    }
-                }
-                out.push(crate::linearised_contact::ConstraintRow { coef, weight: row.weight, eps: row.eps, trial: row.trial, active: row.active, id: (pi, row.point) });
+            for mut row in pair.linearised_rows() {
+                row.coef = row.coef.iter().filter_map(|&(d, c)| equation_of(&self.dofs, d).map(|e| (e, c))).collect();
+                row.id.0 = pi;
+                out.push(row);
             }
         }
         out

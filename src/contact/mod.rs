@@ -26,6 +26,7 @@
 //! The default eps_reg is [`automatic_eps_reg`]: a contact spring per node that is a fixed multiple
 //! of the plate's membrane stiffness around it.
 
+use crate::linearised_contact::ConstraintRow;
 use crate::surface::ContactSurface;
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -288,20 +289,6 @@ impl SiteContext<'_> {
             }
         }
     }
-}
-
-/// A contact point's constraint linearised at the last evaluation ([`ContactPair::linearised_rows`]):
-/// the trial multiplier `trial + eps * grad . (du at dofs)`.
-#[derive(Debug, Clone, Copy)]
-pub struct LinearisedRow {
-    pub point: usize,
-    /// The point's three displacement dofs and the force-driven punch's travel (usize::MAX: none).
-    pub dofs: [usize; 4],
-    pub grad: [f64; 4],
-    pub weight: f64,
-    pub eps: f64,
-    pub trial: f64,
-    pub active: bool,
 }
 
 /// The default [`ContactPair::release_fraction`]. A Newton step that puts a band of points onto
@@ -1066,11 +1053,13 @@ impl ContactPair {
     }
 
     /// Each point's constraint linearised at the last evaluation, for the re-solve of the
-    /// linearised contact problem ([`crate::linearised_contact`]): nodal contact only (the
+    /// linearised contact problem ([`crate::linearised_contact`]), its coefficients by dof (the
+    /// point's three displacements, and the force-driven punch's travel) and its id (0, point):
+    /// the model renumbers them to equations and sets the pair. Nodal contact only (the
     /// integrated scheme's rows couple a node's cells), not with the paper's fixed set
     /// (`hold_active_set`), not the points that cycled (they keep the active side) nor those with
     /// no gradient.
-    pub fn linearised_rows(&self) -> Vec<LinearisedRow> {
+    pub fn linearised_rows(&self) -> Vec<ConstraintRow> {
         if self.face.is_some() || self.hold_active_set {
             return Vec::new();
         }
@@ -1081,20 +1070,13 @@ impl ContactPair {
             if self.frozen[k] || g.norm() == 0.0 {
                 continue;
             }
+            let mut coef: Vec<(usize, f64)> = (0..3).map(|i| (p.dofs[i], g[i])).collect();
             // the force-driven punch's travel s moves the point against the punch by -dn
-            let (drive_dof, grad_s) = match &self.drive {
-                Some(f) => (f.dof, -g.dot(&dn)),
-                None => (usize::MAX, 0.0),
-            };
-            out.push(LinearisedRow {
-                point: k,
-                dofs: [p.dofs[0], p.dofs[1], p.dofs[2], drive_dof],
-                grad: [g[0], g[1], g[2], grad_s],
-                weight: p.weight,
-                eps: self.eps_reg,
-                trial: self.lambda_bar[k] + self.eps_reg * s.psi,
-                active: s.active,
-            });
+            if let Some(f) = &self.drive {
+                coef.push((f.dof, -g.dot(&dn)));
+            }
+            coef.retain(|&(_, c)| c != 0.0);
+            out.push(ConstraintRow { coef, weight: p.weight, eps: self.eps_reg, trial: self.lambda_bar[k] + self.eps_reg * s.psi, active: s.active, id: (0, k) });
         }
         out
     }

@@ -87,6 +87,29 @@ impl<S: LinearSolver> BorderedSolver<S> {
         &self.inner
     }
 
+    /// The border's part of a solve, with z = A11^-1 b1 already in `b1`: x2 = S^-1 (b2 - A21 z)
+    /// into `b2`, x1 = z - Y x2 into `b1`.
+    fn finish_border(&self, b1: &mut [f64], b2: &mut [f64]) -> Result<()> {
+        let (n0, m) = (self.n0, self.border);
+        let Some(schur) = self.schur.as_ref() else {
+            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
+        };
+        let mut r = nalgebra::DVector::<f64>::zeros(m);
+        for k in 0..m {
+            let row = &self.a21_dense[k * n0..(k + 1) * n0];
+            r[k] = b2[k] - row.iter().zip(b1.iter()).map(|(a, z)| a * z).sum::<f64>();
+        }
+        let x2 = schur.solve(&r).ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
+        for k in 0..m {
+            b2[k] = x2[k];
+            let col = &self.y[k * n0..(k + 1) * n0];
+            for (x, yv) in b1.iter_mut().zip(col) {
+                *x -= yv * x2[k];
+            }
+        }
+        Ok(())
+    }
+
     fn build_maps(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
         let n = a.ncols();
         let m = self.border;
@@ -219,26 +242,9 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         if self.border == 0 {
             return self.inner.solve_in_place_to(b, rtol);
         }
-        let (n0, m) = (self.n0, self.border);
-        let Some(schur) = self.schur.as_ref() else {
-            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
-        };
-        let (b1, b2) = b.split_at_mut(n0);
+        let (b1, b2) = b.split_at_mut(self.n0);
         self.inner.solve_in_place_to(b1, rtol)?;
-        // x2 = S^-1 (b2 - A21 z)
-        let mut r = nalgebra::DVector::<f64>::zeros(m);
-        for k in 0..m {
-            let row = &self.a21_dense[k * n0..(k + 1) * n0];
-            r[k] = b2[k] - row.iter().zip(b1.iter()).map(|(a, z)| a * z).sum::<f64>();
-        }
-        let x2 = schur.solve(&r).ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
-        for k in 0..m {
-            b2[k] = x2[k];
-            let col = &self.y[k * n0..(k + 1) * n0];
-            for (x, yv) in b1.iter_mut().zip(col) {
-                *x -= yv * x2[k];
-            }
-        }
+        self.finish_border(b1, b2)?;
         if b.iter().any(|x| !x.is_finite()) {
             return Err(StampError::LinearSolver("the solution has non-finite entries: the matrix is singular".into()));
         }
@@ -261,25 +267,10 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
             l.copy_from_slice(&c[..n0]);
         }
         self.inner.solve_many_approx(&mut lead, ncols)?;
-        let Some(schur) = self.schur.as_ref() else {
-            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
-        };
         for (z, c) in lead.chunks(n0).zip(b.chunks_mut(n)) {
             let (b1, b2) = c.split_at_mut(n0);
-            let mut r = nalgebra::DVector::<f64>::zeros(m);
-            for k in 0..m {
-                let row = &self.a21_dense[k * n0..(k + 1) * n0];
-                r[k] = b2[k] - row.iter().zip(z).map(|(a, z)| a * z).sum::<f64>();
-            }
-            let x2 = schur.solve(&r).ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
             b1.copy_from_slice(z);
-            for k in 0..m {
-                b2[k] = x2[k];
-                let col = &self.y[k * n0..(k + 1) * n0];
-                for (x, yv) in b1.iter_mut().zip(col) {
-                    *x -= yv * x2[k];
-                }
-            }
+            self.finish_border(b1, b2)?;
         }
         Ok(())
     }
