@@ -234,7 +234,8 @@ fn add_columns<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
         Some(fc) => {
             forward.extend(fc);
             for j in base..total {
-                let col: Vec<f64> = (0..total).map(|i| forward[j].dot(&forward[i])).collect();
+                // g_i K^-1 g_j, as the whole columns' below (K bordered is not symmetric)
+                let col: Vec<f64> = (0..total).map(|i| forward[i].dot(&forward[j])).collect();
                 for i in 0..base {
                     compliance[i][j] = col[i];
                 }
