@@ -156,7 +156,9 @@ fn arbitrary_rotation_of_the_deformed_state_on_a_distorted_mesh() {
 }
 
 fn superposed_rotation(mesh: QuadMesh, what: &str) {
-    let mut m0 = model(&mesh, Sphere::new(Vector3::from(CENTRE), RADIUS).unwrap(), MOTION, LOAD);
+    // Psi about the pole facing the plate (Sphere::new's), which turns with the plate below
+    let pole = -Vector3::z();
+    let mut m0 = model(&mesh, Sphere::with_pole(Vector3::from(CENTRE), RADIUS, pole).unwrap(), MOTION, LOAD);
     let u0 = solve(&mut m0);
     m0.evaluate(&u0, 1.0, false).unwrap();
     let f0 = m0.nodal_forces().to_vec();
@@ -181,7 +183,7 @@ fn superposed_rotation(mesh: QuadMesh, what: &str) {
         }
         // the punch where it was at load factor 1, moved the same way; the load turned with it
         let centre = q * (Vector3::from(CENTRE) + Vector3::from(MOTION)) + c;
-        let mut m1 = model(&mesh, Sphere::new(centre, RADIUS).unwrap(), [0.0; 3], (q * Vector3::from(LOAD)).into());
+        let mut m1 = model(&mesh, Sphere::with_pole(centre, RADIUS, q * pole).unwrap(), [0.0; 3], (q * Vector3::from(LOAD)).into());
         m1.evaluate(&u1, 1.0, false).unwrap();
         let f1 = m1.nodal_forces();
         let mut force_error = 0.0f64;
@@ -217,8 +219,10 @@ fn superposed_rotation(mesh: QuadMesh, what: &str) {
             "{what}: Q from Euler-Krylov angles {angles:?}, c = {shift:?}: nodal forces vs Q f: {force_error:.2e}; rotated residual {residual:.2e} (original {original_residual:.2e}); contact lambda/grad {contact_error:.2e}; reaction {reaction_error:.2e}; energy {energy_error:.2e} (all relative)"
         );
         assert!(force_error < 1e-10, "nodal forces do not rotate with Q: {force_error:e}");
-        // as much in equilibrium as the solved state (which Newton left at its tolerance)
-        assert!(original_residual < 1e-9 && (residual - original_residual).abs() < 1e-11, "the moved state's residual {residual:e} against the solved state's {original_residual:e}");
+        // as much in equilibrium as the solved state (which Newton left at its tolerance), up to
+        // how well the forces turned (r1 = Q r0 + f1 - Q f0: a component of the last within
+        // sqrt(3) of its largest)
+        assert!(original_residual < 1e-9 && (residual - original_residual).abs() <= 3f64.sqrt() * force_error + 1e-13, "the moved state's residual {residual:e} against the solved state's {original_residual:e} (forces turned to {force_error:e})");
         assert!(contact_error < 1e-8 && reaction_error < 1e-8, "contact forces do not rotate with Q: {contact_error:e}, {reaction_error:e}");
         assert!(energy_error < 1e-10, "strain energy changed under a rigid motion: {energy_error:e}");
     }

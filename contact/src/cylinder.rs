@@ -11,6 +11,12 @@ use stamp::Result;
 /// the axis minus R^2. For the axis along x1 through (0, 0, R) this is the paper's eq. 3.6,
 /// Psi = x2^2 + (x3 - R)^2 - R^2. The gradient is 2 r_perp and the Hessian 2 (I - a a^T).
 ///
+/// Psi is evaluated as |y_perp|^2 + 2 R y . e with y = x - q, q = point + R e on the line of
+/// the cylinder facing the plate's midplane x3 = 0 (e perpendicular to the axis, towards x3 = 0):
+/// the same function without the cancellation of |r_perp|^2 against R^2 near that line, where
+/// the plate touches (as [`crate::Sphere`]'s pole). An axis within 60 degrees of x3 has no such
+/// line and keeps the plain form.
+///
 /// Fields are private so that the axis stays normalised and the radius positive; build one with
 /// [`Cylinder::new`] or [`Cylinder::along_x1_touching`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,6 +24,9 @@ pub struct Cylinder {
     point: Vector3<f64>,
     axis: Vector3<f64>,
     radius: f64,
+    /// The line facing the midplane, q = point + R e, and e (zero: the plain form).
+    near: Vector3<f64>,
+    normal: Vector3<f64>,
 }
 
 impl Cylinder {
@@ -30,7 +39,10 @@ impl Cylinder {
         check_finite_vector("cylinder", "axis point", &point)?;
         let axis = unit_direction("cylinder", "axis direction", &axis)?;
         let radius = check_radius("cylinder", radius)?;
-        Ok(Self { point, axis, radius })
+        let down = Vector3::new(0.0, 0.0, if point.z > 0.0 { -1.0 } else { 1.0 });
+        let across = down - down.dot(&axis) * axis;
+        let normal = if across.norm() >= 0.5 { across.normalize() } else { Vector3::zeros() };
+        Ok(Self { point, axis, radius, near: point + radius * normal, normal })
     }
 
     /// A cylinder with its axis along x1 that touches the plane x3 = `top_z` from above along the
@@ -67,7 +79,13 @@ impl Cylinder {
 
 impl ContactSurface for Cylinder {
     fn psi(&self, x: &Vector3<f64>) -> f64 {
-        self.r_perp(x).norm_squared() - self.radius * self.radius
+        if self.normal == Vector3::zeros() {
+            return self.r_perp(x).norm_squared() - self.radius * self.radius;
+        }
+        // |r_perp|^2 - R^2 = |y_perp + R e|^2 - R^2 = |y_perp|^2 + 2 R y . e (e normal to a)
+        let y = x - self.near;
+        let y_perp = y - y.dot(&self.axis) * self.axis;
+        y_perp.norm_squared() + 2.0 * self.radius * y.dot(&self.normal)
     }
 
     fn gradient(&self, x: &Vector3<f64>) -> Vector3<f64> {

@@ -410,3 +410,40 @@ fn length_scale_and_describe() {
     let all: Vec<Box<dyn ContactSurface>> = vec![Box::new(c), Box::new(s), Box::new(p)];
     assert_eq!(all.len(), 3);
 }
+
+/// Near the point that touches the plate, Psi is exact where |x - c|^2 - R^2 loses the low bits
+/// of |x - c|^2 ~ R^2: at x = (0.25, 0.5, 0.5 - 2^-20) under a sphere of radius 200 touching
+/// x3 = 0.5 (and a cylinder of radius 100 along x1), Psi = 0.3125 + 2 R 2^-20 + 2^-40 exactly
+/// (every number here is a float); the plain form is off by 9e-13 there (its 2^-40 is lost in
+/// |x - c|^2 = 40000.3...). Above and below the plate, far from the pole, the two forms agree.
+#[test]
+fn psi_is_exact_near_the_touching_point_of_a_large_sphere_or_cylinder() {
+    let tiny = 2f64.powi(-20);
+    let sphere = Sphere::new(Vector3::new(0.0, 0.0, 200.5), 200.0).unwrap();
+    let x = Vector3::new(0.25, 0.5, 0.5 - tiny);
+    let exact = 0.3125 + 400.0 * tiny + tiny * tiny;
+    assert_eq!(sphere.psi(&x), exact, "sphere: Psi near the pole");
+    let plain = (x - sphere.center()).norm_squared() - 200.0 * 200.0;
+    assert!((plain - exact).abs() > 1e-13, "the plain form was exact here too ({plain} against {exact}): the test shows nothing");
+    let cylinder = Cylinder::along_x1_touching(0.0, 0.5, 100.0).unwrap();
+    let x = Vector3::new(3.0, 0.25, 0.5 - tiny);
+    assert_eq!(cylinder.psi(&x), 0.0625 + 200.0 * tiny + tiny * tiny, "cylinder: Psi near its touching line");
+    // the same function everywhere: a sphere below the plate, points far from the pole, an
+    // oblique cylinder, and a vertical one (the plain form)
+    let below = Sphere::new(Vector3::new(1.0, -2.0, -30.0), 29.0).unwrap();
+    let oblique = Cylinder::new(Vector3::new(1.0, 2.0, 40.0), Vector3::new(1.0, 1.0, 0.3), 39.0).unwrap();
+    let vertical = Cylinder::new(Vector3::new(1.0, 2.0, 40.0), Vector3::new(0.1, 0.0, 1.0), 3.0).unwrap();
+    let mut rng = Lcg(7);
+    for _ in 0..200 {
+        let x = Vector3::new(rng.uniform(-60.0, 60.0), rng.uniform(-60.0, 60.0), rng.uniform(-60.0, 60.0));
+        let d = x - below.center();
+        let want = d.norm_squared() - 29.0 * 29.0;
+        assert!((below.psi(&x) - want).abs() <= 1e-12 * d.norm_squared(), "sphere below at {x:?}");
+        for (c, r) in [(&oblique, 39.0), (&vertical, 3.0)] {
+            let rv = x - c.point();
+            let perp = rv - rv.dot(&c.axis()) * c.axis();
+            let want = perp.norm_squared() - r * r;
+            assert!((c.psi(&x) - want).abs() <= 1e-11 * (rv.norm_squared() + r * r), "cylinder of radius {r} at {x:?}: {} against {want}", c.psi(&x));
+        }
+    }
+}
