@@ -65,6 +65,13 @@ const FUNCTIONS: &[&str] = &[
     "PCFactorSetMatSolverType",
     "PCFactorGetMatSolverType",
     "PCGetFailedReason",
+    "PCApply",
+    "PCFactorGetMatrix",
+    "MatMumpsGetInverseTranspose",
+    "MatMumpsGetIcntl",
+    "MatMumpsSetIcntl",
+    "MatGetRow",
+    "MatRestoreRow",
 ];
 
 /// The binding's types, for documentation without PETSc.

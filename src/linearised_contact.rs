@@ -14,8 +14,9 @@
 //! U the changed points' gradients g_k, S their +-w_k eps_k, until no point disagrees (a few
 //! rounds). The compliance U^T K^-1 U between the changed points comes from the forward halves of
 //! the factor ([`LinearSolver::forward_columns`]: the rows on their paths to the root of the
-//! elimination tree) or, for a factor without them, from whole solves of the changed points'
-//! columns at once ([`LinearSolver::solve_many_approx`]); both with the symmetric factor (the
+//! elimination tree), from selected entries of its inverse ([`LinearSolver::compliance`]: MUMPS
+//! under PETSc) or, for a factor without either, from whole solves of the changed points'
+//! columns at once ([`LinearSolver::solve_many_approx`]); all with the symmetric factor (the
 //! preconditioner of an unsymmetric tangent), an estimate that only chooses the set. Each round
 //! costs one solve with the factor (the trials of every point); the step is corrected with one
 //! accurate solve. The set found is handed to the problem for its next evaluation
@@ -244,6 +245,18 @@ fn add_columns<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
         }
         None => {
             forward.clear();
+            // selected entries of the factor's inverse (MUMPS), else whole columns
+            let all: Vec<Vec<(usize, f64)>> = changed_rows.iter().map(|&k| rows[k].coef.clone()).collect();
+            if let Some(c) = linear.compliance(&all, &coefs)? {
+                for (ci, j) in (base..total).enumerate() {
+                    let col: Vec<f64> = (0..total).map(|i| c[(i, ci)]).collect();
+                    for i in 0..base {
+                        compliance[i][j] = col[i];
+                    }
+                    compliance.push(col);
+                }
+                return Ok(());
+            }
             let m = new.len();
             let mut cols = vec![0.0; n * m];
             for (c, g) in coefs.iter().enumerate() {

@@ -624,20 +624,17 @@ impl<E: Element> NonlinearProblem for Model<E> {
         }
     }
     /// The contact points of every pair, their coefficients renumbered from dofs to equations
-    /// (a prescribed dof's dropped); none on several processes (each holds only its own points).
-    fn constraint_rows(&self) -> Vec<crate::linearised_contact::ConstraintRow> {
-        if self.share.is_some() {
-            return Vec::new();
-        }
+    /// (a prescribed dof's dropped); with a share every point's, from its owner (collective).
+    fn constraint_rows(&self) -> Result<Vec<crate::linearised_contact::ConstraintRow>> {
         let mut out = Vec::new();
         for (pi, pair) in self.contacts.iter().enumerate() {
-            for mut row in pair.linearised_rows() {
+            for mut row in pair.linearised_rows()? {
                 row.coef = row.coef.iter().filter_map(|&(d, c)| equation_of(&self.dofs, d).map(|e| (e, c))).collect();
                 row.id.0 = pi;
                 out.push(row);
             }
         }
-        out
+        Ok(out)
     }
     fn set_constraint_state(&mut self, id: (usize, usize), active: bool) {
         self.contacts[id.0].set_linearised_state(id.1, active);

@@ -55,9 +55,10 @@ pub trait NonlinearProblem {
     fn add_increment(&self, u: &mut [f64], du: &[f64]);
     /// The inequality constraints linearised at the last evaluation, for the re-solve of the
     /// linearised contact problem on each factorisation ([`crate::linearised_contact`]); empty
-    /// (the default) where the problem has none or the re-solve does not apply to them.
-    fn constraint_rows(&self) -> Vec<ConstraintRow> {
-        Vec::new()
+    /// (the default) where the problem has none or the re-solve does not apply to them. On
+    /// several processes every process must get every row, the same (a collective call).
+    fn constraint_rows(&self) -> Result<Vec<ConstraintRow>> {
+        Ok(Vec::new())
     }
     /// Set a constraint's state (active or not) for the next evaluation, as the re-solve found it.
     fn set_constraint_state(&mut self, id: (usize, usize), active: bool) {
@@ -627,7 +628,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
                 *x = -*x;
             }
             if !chord && s.resolve_contact {
-                let rows = p.constraint_rows();
+                let rows = p.constraint_rows().map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
                 if !rows.is_empty() {
                     let mut report = Resolve::default();
                     let changes = resolve(&mut self.linear, &rows, &mut du, &mut report).map_err(|e| (e.to_string(), ev.residual_norm, tol))?;
@@ -1322,8 +1323,8 @@ mod resolve_tests {
         fn add_increment(&self, u: &mut [f64], du: &[f64]) {
             u.iter_mut().zip(du).for_each(|(a, b)| *a += b);
         }
-        fn constraint_rows(&self) -> Vec<ConstraintRow> {
-            (0..self.n).map(|i| ConstraintRow { coef: vec![(i, 1.0)], weight: 1.0, eps: self.eps, trial: self.eps * self.psi[i], active: self.active[i], id: (0, i) }).collect()
+        fn constraint_rows(&self) -> crate::error::Result<Vec<ConstraintRow>> {
+            Ok((0..self.n).map(|i| ConstraintRow { coef: vec![(i, 1.0)], weight: 1.0, eps: self.eps, trial: self.eps * self.psi[i], active: self.active[i], id: (0, i) }).collect())
         }
         fn set_constraint_state(&mut self, id: (usize, usize), active: bool) {
             self.active[id.1] = active;

@@ -308,10 +308,14 @@ struct Call {
 /// After the script: every point's (psi, lambda, active), the pressures, the reaction.
 type Ending = (Vec<(f64, f64, bool)>, Vec<f64>, [f64; 3]);
 
+/// The re-solve's rows at a tangent evaluation: (id, coefficients, weight, eps, trial, active).
+type Rows = Vec<((usize, usize), Vec<(usize, f64)>, f64, f64, f64, bool)>;
+
 /// Newton's calls on a model, in order: a step start, evaluations with and without a tangent
 /// through a contact that grows, the multiplier update, the active-set update, a checkpoint.
-fn script(m: &mut Model<PlateElements>, states: &[Vec<f64>]) -> (Vec<Call>, Ending) {
+fn script(m: &mut Model<PlateElements>, states: &[Vec<f64>]) -> (Vec<Call>, Ending, Vec<Rows>) {
     let mut calls = Vec::new();
+    let mut rows = Vec::new();
     let mut record = |m: &mut Model<PlateElements>, what: &'static str, u: &[f64], tangent: bool| {
         let ev = m.evaluate(u, 1.0, tangent).unwrap();
         calls.push(Call { what, residual: m.residual().to_vec(), norm: ev.residual_norm, scale: ev.force_scale, changes: ev.active_changes });
@@ -321,6 +325,16 @@ fn script(m: &mut Model<PlateElements>, states: &[Vec<f64>]) -> (Vec<Call>, Endi
     for (k, u) in states.iter().enumerate() {
         record(m, "trial", u, false);
         record(m, "tangent", u, true);
+        // the re-solve's rows (every point's on every share), and a state it hands back: the
+        // least penetrating of the points out of contact enters, the next evaluation's business
+        let r: Rows = m.constraint_rows().unwrap().into_iter().map(|r| (r.id, r.coef, r.weight, r.eps, r.trial, r.active)).collect();
+        if k == 0 {
+            if let Some(enter) = r.iter().filter(|r| !r.5).min_by(|a, b| a.4.abs().total_cmp(&b.4.abs())) {
+                m.set_constraint_state(enter.0, true);
+                record(m, "after a re-solve's state", u, true);
+            }
+        }
+        rows.push(r);
         if k == 1 {
             let updated = m.update_multipliers();
             record(m, if updated { "after an update" } else { "no update" }, u, true);
@@ -331,7 +345,7 @@ fn script(m: &mut Model<PlateElements>, states: &[Vec<f64>]) -> (Vec<Call>, Endi
     m.checkpoint();
     let c = &m.contacts[0];
     let state = c.state.iter().map(|s| (s.psi, s.lambda, s.active)).collect();
-    (calls, (state, c.pressures(), c.reaction()))
+    (calls, (state, c.pressures(), c.reaction()), rows)
 }
 
 /// Both discretisations: the shares' scripted runs are the whole model's, each share queried the
@@ -352,14 +366,21 @@ fn shares_evaluate_their_own_contact_points_and_agree_with_the_whole_model() {
                 u
             })
             .collect();
-        let (calls, ending) = script(&mut whole, &states);
+        let (calls, ending, rows) = script(&mut whole, &states);
         let whole_queries = surface.queries.load(Ordering::Relaxed);
         let kind = if integrated { "integrated" } else { "nodal" };
         let active = ending.0.iter().filter(|s| s.2).count();
         assert!(active >= 6, "{kind}: {active} points in contact at the end");
         assert!(calls.iter().any(|c| c.what == "after an update"), "{kind}: the script made no multiplier update: {:?}", calls.iter().map(|c| c.what).collect::<Vec<_>>());
         assert!(calls.iter().any(|c| c.changes > 0), "{kind}: no active-set change in the script");
-        let runs: Vec<(Vec<Call>, Ending, usize)> = std::thread::scope(|s| {
+        // the re-solve is the nodal scheme's: rows at every tangent, one of them handed back
+        let row_count: Vec<usize> = rows.iter().map(|r| r.len()).collect();
+        if integrated {
+            assert!(row_count.iter().all(|&n| n == 0), "integrated: rows {row_count:?}");
+        } else {
+            assert!(row_count.iter().all(|&n| n >= 6) && calls.iter().any(|c| c.what == "after a re-solve's state"), "nodal: rows {row_count:?}");
+        }
+        let runs: Vec<(Vec<Call>, Ending, usize, Vec<Rows>)> = std::thread::scope(|s| {
             let handles: Vec<_> = shares(&mesh)
                 .0
                 .into_iter()
@@ -369,15 +390,17 @@ fn shares_evaluate_their_own_contact_points_and_agree_with_the_whole_model() {
                         let surface = sphere();
                         let mut m = contact_model(mesh, integrated, surface.clone());
                         m.set_share(Some(share)).unwrap();
-                        let (calls, ending) = script(&mut m, states);
-                        (calls, ending, surface.queries.load(Ordering::Relaxed))
+                        let (calls, ending, rows) = script(&mut m, states);
+                        (calls, ending, surface.queries.load(Ordering::Relaxed), rows)
                     })
                 })
                 .collect();
             handles.into_iter().map(|h| h.join().unwrap()).collect()
         });
         let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-11 * scale.max(1e-300);
-        for (i, (c, e, queries)) in runs.iter().enumerate() {
+        for (i, (c, e, queries, r)) in runs.iter().enumerate() {
+            // every share holds every row, the whole model's to the bit (each from its owner)
+            assert_eq!(r, &rows, "{kind}, share {i}: the re-solve's rows");
             assert_eq!(c.len(), calls.len(), "{kind}, share {i}: calls");
             for (a, b) in c.iter().zip(&calls) {
                 assert_eq!((a.what, a.changes), (b.what, b.changes), "{kind}, share {i}: {} changes", b.what);

@@ -122,6 +122,31 @@ impl Ksp {
         Ok(report)
     }
 
+    /// x = M^-1 b with the preconditioner alone (collective; after [`Ksp::set_up`]): MUMPS's
+    /// factor's solve, one multigrid cycle, ...
+    pub fn apply_preconditioner(&self, b: &DVec, x: &mut DVec) -> Result<()> {
+        let pc = self.pc()?;
+        check(unsafe { ffi::PCApply(pc, b.raw, x.raw) })
+    }
+
+    /// Selected entries of the inverse of the factorisation preconditioner's matrix, computed
+    /// by MUMPS (ICNTL(30)) into `requested`: its row j holds the entries (i, j) of the inverse
+    /// at its pattern, every row on rank 0 (MatMumpsGetInverseTranspose). Collective; only with
+    /// MUMPS's factor ([`Ksp::factor_solver`]). The solve controls it sets are restored after.
+    pub fn inverse_entries(&self, requested: &mut AijMatrix) -> Result<()> {
+        let mut f = std::ptr::null_mut();
+        check(unsafe { ffi::PCFactorGetMatrix(self.pc()?, &mut f) })?;
+        let mut saved = [0 as ffi::PetscInt; 3];
+        for (k, icntl) in [20, 21, 30].into_iter().enumerate() {
+            check(unsafe { ffi::MatMumpsGetIcntl(f, icntl, &mut saved[k]) })?;
+        }
+        let got = check(unsafe { ffi::MatMumpsGetInverseTranspose(f, requested.raw) });
+        for (k, icntl) in [20, 21, 30].into_iter().enumerate() {
+            check(unsafe { ffi::MatMumpsSetIcntl(f, icntl, saved[k]) })?;
+        }
+        got
+    }
+
     /// Why the preconditioner failed on this rank, in PETSc's words and ours.
     fn pc_failure(&self) -> String {
         let mut r = ffi::PCFailedReason_PC_NOERROR;

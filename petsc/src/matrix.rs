@@ -149,6 +149,18 @@ impl AijMatrix {
         Ok(())
     }
 
+    /// The values of this rank's row `row` (global), in the pattern's order.
+    pub fn row_values(&self, row: usize, out: &mut Vec<f64>) -> Result<()> {
+        let (mut n, mut cols, mut vals) = (0, std::ptr::null(), std::ptr::null());
+        let r = pint(row)?;
+        check(unsafe { ffi::MatGetRow(self.raw, r, &mut n, &mut cols, &mut vals) })?;
+        out.clear();
+        if n > 0 {
+            out.extend_from_slice(unsafe { std::slice::from_raw_parts(vals, n as usize) });
+        }
+        check(unsafe { ffi::MatRestoreRow(self.raw, r, &mut n, &mut cols, &mut vals) })
+    }
+
     /// y = A x (collective).
     pub fn mult(&self, x: &DVec, y: &mut DVec) -> Result<()> {
         check(unsafe { ffi::MatMult(self.raw, x.raw, y.raw) })

@@ -380,6 +380,98 @@ impl PetscSolver {
     }
 }
 
+impl PetscSolver {
+    fn compliance_local(&mut self, a: &[Vec<(usize, f64)>], b: &[Vec<(usize, f64)>]) -> std::result::Result<nalgebra::DMatrix<f64>, PetscError> {
+        let s = self.setup.as_mut().ok_or_else(|| PetscError::new("solve called without a successful factorisation"))?;
+        let n = s.key.0;
+        let t = Instant::now();
+        // the PETSc rows of the vectors' indices
+        let rows_of = |v: &[Vec<(usize, f64)>]| -> std::result::Result<Vec<usize>, PetscError> {
+            let mut r = Vec::new();
+            for &(e, _) in v.iter().flatten() {
+                r.push(*s.perm.get(e).ok_or_else(|| PetscError::new(format!("index {e} of a matrix of {n} rows")))?);
+            }
+            r.sort_unstable();
+            r.dedup();
+            Ok(r)
+        };
+        let (rows, cols) = (rows_of(a)?, rows_of(b)?);
+        // the requested entries (i, j), i in rows, j in cols: row j of a matrix on rank 0
+        let root = self.petsc.rank() == 0;
+        let (lo, hi) = if root { (0, n) } else { (n, n) };
+        let mut row_ptr = vec![0usize; hi - lo + 1];
+        let mut pattern = Vec::new();
+        if root {
+            let mut next = cols.iter().peekable();
+            for j in 0..n {
+                if next.peek() == Some(&&j) {
+                    next.next();
+                    for &i in &rows {
+                        pattern.push(pint(i)?);
+                    }
+                }
+                row_ptr[j + 1] = pattern.len();
+            }
+        }
+        let nnz = pattern.len();
+        let mut requested = AijMatrix::new(&self.petsc, RowPattern { lo, hi, n, row_ptr, cols: pattern })?;
+        requested.set_values(&vec![0.0; nnz])?;
+        s.ksp.inverse_entries(&mut requested)?;
+        let mut entries = vec![0.0; rows.len() * cols.len()];
+        if root {
+            let mut row = Vec::new();
+            for (c, &j) in cols.iter().enumerate() {
+                requested.row_values(j, &mut row)?;
+                if row.len() != rows.len() {
+                    return Err(PetscError::new(format!("MUMPS gave {} entries of the inverse in row {j}, {} requested", row.len(), rows.len())));
+                }
+                entries[c * rows.len()..(c + 1) * rows.len()].copy_from_slice(&row);
+            }
+        }
+        self.petsc.sum_f64(&mut entries)?;
+        let at = |list: &[usize], e: usize| list.binary_search(&s.perm[e]).expect("an index of the vectors");
+        let mut out = nalgebra::DMatrix::zeros(a.len(), b.len());
+        for (i, ga) in a.iter().enumerate() {
+            for (j, gb) in b.iter().enumerate() {
+                let mut sum = 0.0;
+                for &(f, y) in gb {
+                    let base = at(&cols, f) * rows.len();
+                    for &(e, x) in ga {
+                        sum += x * entries[base + at(&rows, e)] * y;
+                    }
+                }
+                out[(i, j)] = sum;
+            }
+        }
+        self.timings.solve += t.elapsed().as_secs_f64();
+        if out.iter().any(|x| !x.is_finite()) {
+            return Err(PetscError::new("the inverse's entries are not finite: the matrix is singular"));
+        }
+        Ok(out)
+    }
+
+    fn precondition_local(&mut self, b: &mut [f64], ncols: usize) -> std::result::Result<(), PetscError> {
+        let s = self.setup.as_mut().ok_or_else(|| PetscError::new("solve called without a successful factorisation"))?;
+        let n = s.key.0;
+        if ncols == 0 || b.len() != n * ncols {
+            return if b.is_empty() { Ok(()) } else { Err(PetscError::new(format!("{} entries for {ncols} columns of a matrix of {n} rows", b.len()))) };
+        }
+        let t = Instant::now();
+        for col in b.chunks_mut(n) {
+            let own = &s.own;
+            s.b.with_local_mut(|x| x.iter_mut().zip(own).for_each(|(x, &i)| *x = col[i]))?;
+            s.ksp.apply_preconditioner(&s.b, &mut s.x)?;
+            s.gather.gather(&s.x, &mut s.full)?;
+            col.iter_mut().zip(&s.perm).for_each(|(x, &k)| *x = s.full[k]);
+        }
+        self.timings.solve += t.elapsed().as_secs_f64();
+        if b.iter().any(|x| !x.is_finite()) {
+            return Err(PetscError::new("the preconditioner gave non-finite entries: the matrix is singular"));
+        }
+        Ok(())
+    }
+}
+
 /// A hash of a compressed-column pattern (its column offsets and row indices).
 fn pattern_hash(a: SparseColMatRef<'_, usize, f64>) -> u64 {
     let sym = a.symbolic();
@@ -409,6 +501,25 @@ impl LinearSolver for PetscSolver {
 
     fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
         let r = if self.factored { self.solve_local(b, rtol) } else { Err(PetscError::new("solve called without a successful factorisation")) };
+        self.agree(r)
+    }
+
+    /// Selected entries of the inverse of MUMPS's factor (of P by default): the entries on the
+    /// vectors' indices only, computed on rank 0 and shared. None without MUMPS (a multigrid
+    /// preconditioner, say).
+    fn compliance(&mut self, a: &[Vec<(usize, f64)>], b: &[Vec<(usize, f64)>]) -> Result<Option<nalgebra::DMatrix<f64>>> {
+        let mumps = self.setup.as_ref().is_some_and(|s| s.ksp.factor_solver().as_deref() == Some("mumps"));
+        if !mumps {
+            return Ok(None);
+        }
+        let r = if self.factored { self.compliance_local(a, b) } else { Err(PetscError::new("solve called without a successful factorisation")) };
+        self.agree(r).map(Some)
+    }
+
+    /// Each column by the preconditioner alone (MUMPS's factor of P by default), as
+    /// `LdltGmres` does with its own: the estimates of the contact points' compliance.
+    fn solve_many_approx(&mut self, b: &mut [f64], ncols: usize) -> Result<()> {
+        let r = if self.factored { self.precondition_local(b, ncols) } else { Err(PetscError::new("solve called without a successful factorisation")) };
         self.agree(r)
     }
 

@@ -13,7 +13,10 @@
 //!   solved through [`PetscSolver`] as stamp's Newton hands it the matrix, with CG + GAMG with and
 //!   without the rigid-body near-null space, and with the default GMRES + MUMPS.
 //! - `unsymmetric`: convection-diffusion A preconditioned by the Laplacian P (today's scheme:
-//!   GMRES on A, MUMPS LDL^T of P), against a manufactured solution and faer's LU of A.
+//!   GMRES on A, MUMPS LDL^T of P), against a manufactured solution and faer's LU of A; and the
+//!   re-solve's estimates with P's factor, the compliance between sparse vectors (MUMPS's
+//!   selected entries of the inverse, the same bits on every rank) and whole columns by the
+//!   preconditioner, against faer's LU of P.
 //! - `shared`: the same A and P handed over in shares ([`PetscSolver::set_partition`]): each
 //!   rank passes its own part of every entry (zeros elsewhere in the common pattern), the rows
 //!   owned in scattered blocks; the sum's solution is faer's LU of the whole A, the same on every
@@ -115,13 +118,18 @@ fn elasticity_patch_test_on_1_2_4_ranks() {
 #[test]
 fn unsymmetric_gmres_preconditioned_by_mumps_ldlt_on_1_2_4_ranks() {
     for ranks in [1, 2, 4] {
-        for m in run("unsymmetric", ranks) {
+        let lines = run("unsymmetric", ranks);
+        let bits: Vec<&String> = lines.iter().map(|m| &m["compliance_bits"]).collect();
+        assert!(bits.windows(2).all(|w| w[0] == w[1]), "{ranks} ranks: the ranks' compliances differ: {bits:?}");
+        for m in lines {
             let (err, vs_faer) = (num(&m, "error"), num(&m, "difference_from_faer"));
             assert!(err < 1e-9 && vs_faer < 1e-9, "{ranks} ranks: error {err:e}, from faer's LU {vs_faer:e}");
             let its = num(&m, "iterations");
             // P is not A: GMRES needs more than one iteration, and few
             assert!((2.0..=40.0).contains(&its), "{ranks} ranks: {its} GMRES iterations");
             assert_eq!(m["solver"], "gmres + cholesky (mumps)");
+            let (c, many) = (num(&m, "compliance_error"), num(&m, "many_error"));
+            assert!(c < 1e-10 && many < 1e-10, "{ranks} ranks: the compliance off by {c:e}, the preconditioner's columns by {many:e}");
         }
     }
 }
@@ -413,11 +421,43 @@ fn unsymmetric(petsc: &Petsc) -> Vec<(String, String)> {
     let max = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     assert_eq!(x, x2, "the same matrix twice: the same answer");
     assert_eq!(s.timings().factorizations, 2);
+    // the estimates of the re-solve of the linearised contact problem, with MUMPS's factor of P:
+    // the compliance a_i^T P^-1 b_j between sparse vectors (selected entries of the inverse),
+    // and whole columns P^-1 b (the preconditioner alone), against faer's LU of P
+    let sparse = |k: usize| -> Vec<(usize, f64)> { (0..1 + k % 3).map(|q| ((k * 997 + q * 131) % n, 1.0 + 0.25 * q as f64 - 0.1 * k as f64)).collect() };
+    let (va, vb): (Vec<_>, Vec<_>) = ((0..7).map(sparse).collect(), (7..12).map(sparse).collect());
+    let c = s.compliance(&va, &vb).unwrap().expect("MUMPS gives selected entries of the inverse");
+    let mut plu = SparseLu::new();
+    plu.factorize(p.as_ref()).unwrap();
+    let (mut worst, mut scale, mut many_error) = (0.0f64, 0.0f64, 0.0f64);
+    let mut columns = vec![0.0; n * vb.len()];
+    for (j, g) in vb.iter().enumerate() {
+        let mut z = vec![0.0; n];
+        for &(e, v) in g {
+            z[e] += v;
+            columns[j * n + e] += v;
+        }
+        plu.solve_in_place(&mut z).unwrap();
+        for (i, f) in va.iter().enumerate() {
+            let want: f64 = f.iter().map(|&(e, v)| v * z[e]).sum();
+            worst = worst.max((c[(i, j)] - want).abs());
+            scale = scale.max(want.abs());
+        }
+        if j == vb.len() - 1 {
+            s.solve_many_approx(&mut columns, vb.len()).unwrap();
+            let zmax = z.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            many_error = max(&columns[j * n..], &z) / zmax;
+        }
+    }
+    let bits = c.iter().fold(0u64, |h, x| (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3));
     vec![
         ("error".into(), format!("{:e}", max(&x, &exact))),
         ("difference_from_faer".into(), format!("{:e}", max(&x, &y))),
         ("iterations".into(), (s.iterations() / 2).to_string()),
         ("solver".into(), s.describe()),
+        ("compliance_error".into(), format!("{:e}", worst / scale)),
+        ("compliance_bits".into(), bits.to_string()),
+        ("many_error".into(), format!("{many_error:e}")),
     ]
 }
 

@@ -1058,27 +1058,43 @@ impl ContactPair {
     /// the model renumbers them to equations and sets the pair. Nodal contact only (the
     /// integrated scheme's rows couple a node's cells), not with the paper's fixed set
     /// (`hold_active_set`), not the points that cycled (they keep the active side) nor those with
-    /// no gradient.
-    pub fn linearised_rows(&self) -> Vec<ConstraintRow> {
+    /// no gradient. Collective with a share: every process gets every point's row.
+    pub fn linearised_rows(&self) -> crate::Result<Vec<ConstraintRow>> {
         if self.face.is_some() || self.hold_active_set {
-            return Vec::new();
+            return Ok(Vec::new());
+        }
+        // with a share, each point's numbers from its owner, summed over the processes (the
+        // others add zeros), so that every process holds every row, the same to the bit:
+        // (in the re-solve, gradient, trial, active) per point
+        const W: usize = 6;
+        let mut whole = vec![0.0; W * self.points.len()];
+        for (k, s) in self.state.iter().enumerate() {
+            let g = Vector3::from(s.grad);
+            if !self.owns(k) || self.frozen[k] || g.norm() == 0.0 {
+                continue;
+            }
+            let trial = self.lambda_bar[k] + self.eps_reg * s.psi;
+            whole[W * k..W * k + W].copy_from_slice(&[1.0, g[0], g[1], g[2], trial, f64::from(u8::from(s.active))]);
+        }
+        if let Some(share) = &self.share {
+            share.reduce.sum(&mut whole)?;
         }
         let dn = self.drive.map(|f| Vector3::from(f.direction)).unwrap_or_else(Vector3::zeros);
         let mut out = Vec::new();
-        for (k, (p, s)) in self.points.iter().zip(&self.state).enumerate() {
-            let g = Vector3::from(s.grad);
-            if self.frozen[k] || g.norm() == 0.0 {
+        for (k, (p, b)) in self.points.iter().zip(whole.chunks_exact(W)).enumerate() {
+            if b[0] == 0.0 {
                 continue;
             }
+            let g = Vector3::new(b[1], b[2], b[3]);
             let mut coef: Vec<(usize, f64)> = (0..3).map(|i| (p.dofs[i], g[i])).collect();
             // the force-driven punch's travel s moves the point against the punch by -dn
             if let Some(f) = &self.drive {
                 coef.push((f.dof, -g.dot(&dn)));
             }
             coef.retain(|&(_, c)| c != 0.0);
-            out.push(ConstraintRow { coef, weight: p.weight, eps: self.eps_reg, trial: self.lambda_bar[k] + self.eps_reg * s.psi, active: s.active, id: (0, k) });
+            out.push(ConstraintRow { coef, weight: p.weight, eps: self.eps_reg, trial: b[4], active: b[5] != 0.0, id: (0, k) });
         }
-        out
+        Ok(out)
     }
 
     /// The state the re-solve found for point k, for the next evaluation: an entering point is

@@ -61,6 +61,40 @@ impl BorderedSolver<LdltGmres> {
 }
 
 impl<S: LinearSolver> BorderedSolver<S> {
+    /// S^-1 of the last factorisation's Schur complement, and z = A11^-1 A21^T (the inner
+    /// solver's estimate), built at the first call after a factorisation.
+    fn border_inverse(&mut self) -> Result<std::sync::Arc<DMatrix<f64>>> {
+        let Some(schur) = self.schur.as_ref() else {
+            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
+        };
+        if self.schur_inverse.is_none() {
+            let inverse = schur.clone().try_inverse().ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
+            self.schur_inverse = Some(std::sync::Arc::new(inverse));
+            self.z = self.a21_dense.clone();
+            self.inner.solve_many_approx(&mut self.z, self.border)?;
+        }
+        Ok(self.schur_inverse.clone().expect("built above"))
+    }
+
+    /// The border's sides of a vector g = (g1, g2) in b^T K^-1 c: (g1 . Y - g2, z^T g1 - g2).
+    fn border_sides(&self, g: &[(usize, f64)]) -> (Vec<f64>, Vec<f64>) {
+        let (n0, m) = (self.n0, self.border);
+        let mut left = vec![0.0; m];
+        let mut right = vec![0.0; m];
+        for &(e, x) in g {
+            if e < n0 {
+                for k in 0..m {
+                    left[k] += x * self.y[k * n0 + e];
+                    right[k] += x * self.z[k * n0 + e];
+                }
+            } else {
+                left[e - n0] -= x;
+                right[e - n0] -= x;
+            }
+        }
+        (left, right)
+    }
+
     /// The same with a given solver for the leading block.
     pub fn with_inner(border: usize, inner: S) -> Self {
         BorderedSolver {
@@ -283,40 +317,39 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         if self.border == 0 {
             return self.inner.forward_columns(b);
         }
-        let (n0, m) = (self.n0, self.border);
+        let n0 = self.n0;
         let lead: Vec<Vec<(usize, f64)>> = b.iter().map(|g| g.iter().copied().filter(|&(e, _)| e < n0).collect()).collect();
         let Some(columns) = self.inner.forward_columns(&lead)? else { return Ok(None) };
-        let Some(schur) = self.schur.as_ref() else {
-            return Err(StampError::LinearSolver("solve called without a successful factorisation".into()));
-        };
-        if self.schur_inverse.is_none() {
-            let inverse = schur.clone().try_inverse().ok_or_else(|| StampError::LinearSolver("singular Schur complement".into()))?;
-            self.schur_inverse = Some(std::sync::Arc::new(inverse));
-            self.z = self.a21_dense.clone();
-            self.inner.solve_many_approx(&mut self.z, m)?;
-        }
-        let inverse = self.schur_inverse.clone().expect("built above");
+        let inverse = self.border_inverse()?;
         let out = columns
             .into_iter()
             .zip(b)
             .map(|(column, g)| {
-                let mut left = vec![0.0; m];
-                let mut right = vec![0.0; m];
-                for &(e, x) in g {
-                    if e < n0 {
-                        for k in 0..m {
-                            left[k] += x * self.y[k * n0 + e];
-                            right[k] += x * self.z[k * n0 + e];
-                        }
-                    } else {
-                        left[e - n0] -= x;
-                        right[e - n0] -= x;
-                    }
-                }
+                let (left, right) = self.border_sides(g);
                 column.with_border(left, right, inverse.clone())
             })
             .collect();
         Ok(Some(out))
+    }
+
+    /// With a border: the inner solver's compliance of the vectors' leading parts, with the
+    /// border's terms of the block inverse as in `forward_columns`.
+    fn compliance(&mut self, a: &[Vec<(usize, f64)>], b: &[Vec<(usize, f64)>]) -> Result<Option<DMatrix<f64>>> {
+        if self.border == 0 {
+            return self.inner.compliance(a, b);
+        }
+        let n0 = self.n0;
+        let lead = |v: &[Vec<(usize, f64)>]| -> Vec<Vec<(usize, f64)>> { v.iter().map(|g| g.iter().copied().filter(|&(e, _)| e < n0).collect()).collect() };
+        let Some(mut c) = self.inner.compliance(&lead(a), &lead(b))? else { return Ok(None) };
+        let inverse = self.border_inverse()?;
+        let right: Vec<nalgebra::DVector<f64>> = b.iter().map(|g| inverse.as_ref() * nalgebra::DVector::from_vec(self.border_sides(g).1)).collect();
+        for (i, g) in a.iter().enumerate() {
+            let left = nalgebra::DVector::from_vec(self.border_sides(g).0);
+            for (j, r) in right.iter().enumerate() {
+                c[(i, j)] += left.dot(r);
+            }
+        }
+        Ok(Some(c))
     }
 
     fn timings(&self) -> SolverTimings {
@@ -365,6 +398,76 @@ mod tests {
                 let expected: f64 = bi.iter().map(|&(e, c)| c * x[e]).sum();
                 let got = columns[i].dot(&columns[j]);
                 assert!((got - expected).abs() <= 1e-10 * expected.abs().max(1e-3), "b{i}^T K^-1 b{j}: {got} against {expected}");
+            }
+        }
+    }
+
+    /// An inner solver with the selected-entries compliance (as PETSc's MUMPS gives it), here
+    /// by whole solves with faer's LU of the leading block.
+    struct Entries(crate::linalg::linear_solver::SparseLu, usize);
+
+    impl LinearSolver for Entries {
+        fn factorize(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<()> {
+            self.1 = a.nrows();
+            self.0.factorize(a)
+        }
+        fn solve_in_place(&mut self, b: &mut [f64]) -> Result<()> {
+            self.0.solve_in_place(b)
+        }
+        fn compliance(&mut self, a: &[Vec<(usize, f64)>], b: &[Vec<(usize, f64)>]) -> Result<Option<DMatrix<f64>>> {
+            let n = self.1;
+            let mut c = DMatrix::zeros(a.len(), b.len());
+            for (j, g) in b.iter().enumerate() {
+                let mut x = vec![0.0; n];
+                g.iter().for_each(|&(e, v)| x[e] += v);
+                self.0.solve_in_place(&mut x)?;
+                for (i, f) in a.iter().enumerate() {
+                    c[(i, j)] = f.iter().map(|&(e, v)| v * x[e]).sum();
+                }
+            }
+            Ok(Some(c))
+        }
+        fn timings(&self) -> SolverTimings {
+            self.0.timings()
+        }
+    }
+
+    /// The compliance a_i^T K^-1 b_j of a bordered matrix (the border unsymmetric) from the inner
+    /// solver's compliance of the leading parts and the block inverse's border terms, against
+    /// whole solves; fails without the border terms.
+    #[test]
+    fn compliance_of_a_bordered_matrix_from_the_inner_compliance() {
+        let k = 30;
+        let n0 = k * k;
+        let mut t = Vec::new();
+        for (x, y) in (0..k).flat_map(|x| (0..k).map(move |y| (x, y))) {
+            let i = x * k + y;
+            t.push(Triplet::new(i, i, 4.01));
+            if x + 1 < k {
+                t.extend([Triplet::new(i, i + k, -1.0), Triplet::new(i + k, i, -1.0)]);
+            }
+            if y + 1 < k {
+                t.extend([Triplet::new(i, i + 1, -1.0), Triplet::new(i + 1, i, -1.0)]);
+            }
+        }
+        // the border: its row and column differ (a force-driven punch's are not each other's transpose)
+        for (i, v, w) in [(10usize, 0.3, 0.2), (n0 / 2, -0.5, -0.4), (n0 / 2 + 7, 0.25, 0.3), (n0 - 5, 0.4, 0.1)] {
+            t.extend([Triplet::new(i, n0, v), Triplet::new(n0, i, w)]);
+        }
+        t.push(Triplet::new(n0, n0, 2.0));
+        let a = SparseColMat::try_new_from_triplets(n0 + 1, n0 + 1, &t).unwrap();
+        let mut solver = BorderedSolver::with_inner(1, Entries(crate::linalg::linear_solver::SparseLu::new(), 0));
+        solver.factorize(a.as_ref()).unwrap();
+        let va: Vec<Vec<(usize, f64)>> = vec![vec![(n0 / 2, 1.0), (n0 / 2 + 1, -0.5), (n0, 0.7)], vec![(12, 2.0)]];
+        let vb: Vec<Vec<(usize, f64)>> = vec![vec![(n0 - 3, 1.0), (n0 / 3, 0.25), (n0, -1.0)], vec![(n0 / 2, 0.5)], vec![(n0, 1.0)]];
+        let c = solver.compliance(&va, &vb).unwrap().expect("the inner solver's compliance through the border");
+        for (j, bj) in vb.iter().enumerate() {
+            let mut x = vec![0.0; n0 + 1];
+            bj.iter().for_each(|&(e, v)| x[e] += v);
+            solver.solve_in_place(&mut x).unwrap();
+            for (i, ai) in va.iter().enumerate() {
+                let expected: f64 = ai.iter().map(|&(e, v)| v * x[e]).sum();
+                assert!((c[(i, j)] - expected).abs() <= 1e-10 * expected.abs().max(1e-3), "a{i}^T K^-1 b{j}: {} against {expected}", c[(i, j)]);
             }
         }
     }

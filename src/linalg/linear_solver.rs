@@ -79,6 +79,15 @@ pub trait LinearSolver: Send {
         let _ = b;
         Ok(None)
     }
+    /// The compliance a_i^T A^-1 b_j between sparse vectors (pairs of an index and a value), as
+    /// a matrix of a's length by b's, to a preconditioner's accuracy, from selected entries of
+    /// the inverse of a symmetric factor (MUMPS's ICNTL(30): the entries on the vectors' indices
+    /// only, each at the cost of its paths in the elimination tree). None where the solver has
+    /// none (the caller then solves whole columns); the default. Collective on several processes.
+    fn compliance(&mut self, a: &[Vec<(usize, f64)>], b: &[Vec<(usize, f64)>]) -> Result<Option<nalgebra::DMatrix<f64>>> {
+        let _ = (a, b);
+        Ok(None)
+    }
     /// Time spent so far.
     fn timings(&self) -> SolverTimings;
 }
