@@ -369,23 +369,8 @@ mod tests {
     fn forward_columns_of_a_bordered_matrix_give_its_compliance() {
         let k = 150;
         let n0 = k * k;
-        let mut t = Vec::new();
-        for (x, y) in (0..k).flat_map(|x| (0..k).map(move |y| (x, y))) {
-            let i = x * k + y;
-            t.push(Triplet::new(i, i, 4.01));
-            if x + 1 < k {
-                t.extend([Triplet::new(i, i + k, -1.0), Triplet::new(i + k, i, -1.0)]);
-            }
-            if y + 1 < k {
-                t.extend([Triplet::new(i, i + 1, -1.0), Triplet::new(i + 1, i, -1.0)]);
-            }
-        }
         // the border: coupled to four unknowns, symmetric, and its own diagonal
-        for (i, v) in [(10usize, 0.3), (n0 / 2, -0.5), (n0 / 2 + 7, 0.25), (n0 - 5, 0.4)] {
-            t.extend([Triplet::new(i, n0, v), Triplet::new(n0, i, v)]);
-        }
-        t.push(Triplet::new(n0, n0, 2.0));
-        let a = SparseColMat::try_new_from_triplets(n0 + 1, n0 + 1, &t).unwrap();
+        let a = grid_with_border(k, &[(10, 0.3, 0.3), (n0 / 2, -0.5, -0.5), (n0 / 2 + 7, 0.25, 0.25), (n0 - 5, 0.4, 0.4)]);
         let mut solver = BorderedSolver::new(1);
         solver.factorize(a.as_ref()).unwrap();
         let vectors: Vec<Vec<(usize, f64)>> = vec![vec![(n0 / 2, 1.0), (n0 / 2 + 1, -0.5), (n0, 0.7)], vec![(12, 2.0)], vec![(n0 - 3, 1.0), (n0 / 3, 0.25), (n0, -1.0)]];
@@ -400,6 +385,28 @@ mod tests {
                 assert!((got - expected).abs() <= 1e-10 * expected.abs().max(1e-3), "b{i}^T K^-1 b{j}: {got} against {expected}");
             }
         }
+    }
+
+    /// The 5-point operator (diagonal 4.01) on a k x k grid bordered by one unknown: column
+    /// entries (i, v) and row entries (i, w) of each triple (i, v, w), diagonal 2.
+    fn grid_with_border(k: usize, border: &[(usize, f64, f64)]) -> SparseColMat<usize, f64> {
+        let n0 = k * k;
+        let mut t = Vec::new();
+        for (x, y) in (0..k).flat_map(|x| (0..k).map(move |y| (x, y))) {
+            let i = x * k + y;
+            t.push(Triplet::new(i, i, 4.01));
+            if x + 1 < k {
+                t.extend([Triplet::new(i, i + k, -1.0), Triplet::new(i + k, i, -1.0)]);
+            }
+            if y + 1 < k {
+                t.extend([Triplet::new(i, i + 1, -1.0), Triplet::new(i + 1, i, -1.0)]);
+            }
+        }
+        for &(i, v, w) in border {
+            t.extend([Triplet::new(i, n0, v), Triplet::new(n0, i, w)]);
+        }
+        t.push(Triplet::new(n0, n0, 2.0));
+        SparseColMat::try_new_from_triplets(n0 + 1, n0 + 1, &t).unwrap()
     }
 
     /// An inner solver with the selected-entries compliance (as PETSc's MUMPS gives it), here
@@ -439,23 +446,8 @@ mod tests {
     fn compliance_of_a_bordered_matrix_from_the_inner_compliance() {
         let k = 30;
         let n0 = k * k;
-        let mut t = Vec::new();
-        for (x, y) in (0..k).flat_map(|x| (0..k).map(move |y| (x, y))) {
-            let i = x * k + y;
-            t.push(Triplet::new(i, i, 4.01));
-            if x + 1 < k {
-                t.extend([Triplet::new(i, i + k, -1.0), Triplet::new(i + k, i, -1.0)]);
-            }
-            if y + 1 < k {
-                t.extend([Triplet::new(i, i + 1, -1.0), Triplet::new(i + 1, i, -1.0)]);
-            }
-        }
         // the border: its row and column differ (a force-driven punch's are not each other's transpose)
-        for (i, v, w) in [(10usize, 0.3, 0.2), (n0 / 2, -0.5, -0.4), (n0 / 2 + 7, 0.25, 0.3), (n0 - 5, 0.4, 0.1)] {
-            t.extend([Triplet::new(i, n0, v), Triplet::new(n0, i, w)]);
-        }
-        t.push(Triplet::new(n0, n0, 2.0));
-        let a = SparseColMat::try_new_from_triplets(n0 + 1, n0 + 1, &t).unwrap();
+        let a = grid_with_border(k, &[(10, 0.3, 0.2), (n0 / 2, -0.5, -0.4), (n0 / 2 + 7, 0.25, 0.3), (n0 - 5, 0.4, 0.1)]);
         let mut solver = BorderedSolver::with_inner(1, Entries(crate::linalg::linear_solver::SparseLu::new(), 0));
         solver.factorize(a.as_ref()).unwrap();
         let va: Vec<Vec<(usize, f64)>> = vec![vec![(n0 / 2, 1.0), (n0 / 2 + 1, -0.5), (n0, 0.7)], vec![(12, 2.0)]];
