@@ -215,6 +215,16 @@ fn scatter(rows: &[ConstraintRow], changed_rows: &[usize], coef: &[f64], b: &mut
     }
 }
 
+/// Appends a new changed row's compliance column `col` (over every changed row) as the last
+/// column, and its entries as the new row of the `base` columns there before this round.
+fn push_column(compliance: &mut Vec<Vec<f64>>, base: usize, col: Vec<f64>) {
+    let j = compliance.len();
+    for (i, w) in compliance.iter_mut().take(base).enumerate() {
+        w[j] = col[i];
+    }
+    compliance.push(col);
+}
+
 /// Appends the rows `new` to the changed rows and their compliance with every changed row,
 /// g_i . K^-1 g_j (symmetric: the symmetric factor).
 #[allow(clippy::too_many_arguments)]
@@ -237,10 +247,7 @@ fn add_columns<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
             for j in base..total {
                 // g_i K^-1 g_j, as the whole columns' below (K bordered is not symmetric)
                 let col: Vec<f64> = (0..total).map(|i| forward[i].dot(&forward[j])).collect();
-                for i in 0..base {
-                    compliance[i][j] = col[i];
-                }
-                compliance.push(col);
+                push_column(compliance, base, col);
             }
         }
         None => {
@@ -248,12 +255,8 @@ fn add_columns<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
             // selected entries of the factor's inverse (MUMPS), else whole columns
             let all: Vec<Vec<(usize, f64)>> = changed_rows.iter().map(|&k| rows[k].coef.clone()).collect();
             if let Some(c) = linear.compliance(&all, &coefs)? {
-                for (ci, j) in (base..total).enumerate() {
-                    let col: Vec<f64> = (0..total).map(|i| c[(i, ci)]).collect();
-                    for i in 0..base {
-                        compliance[i][j] = col[i];
-                    }
-                    compliance.push(col);
+                for ci in 0..new.len() {
+                    push_column(compliance, base, c.column(ci).iter().copied().collect());
                 }
                 return Ok(());
             }
@@ -265,13 +268,8 @@ fn add_columns<L: LinearSolver + ?Sized>(linear: &mut L, rows: &[ConstraintRow],
                 }
             }
             linear.solve_many_approx(&mut cols, m)?;
-            for (c, j) in (base..total).enumerate() {
-                let z = &cols[c * n..(c + 1) * n];
-                let col: Vec<f64> = changed_rows.iter().map(|&k| row_dot(&rows[k], z)).collect();
-                for i in 0..base {
-                    compliance[i][j] = col[i];
-                }
-                compliance.push(col);
+            for z in cols.chunks(n) {
+                push_column(compliance, base, changed_rows.iter().map(|&k| row_dot(&rows[k], z)).collect());
             }
         }
     }

@@ -30,7 +30,7 @@ impl Sphere {
     /// Errors with [`stamp::StampError::Problem`] if the centre is non-finite or the radius is not
     /// finite and strictly positive.
     pub fn new(center: Vector3<f64>, radius: f64) -> Result<Self> {
-        check_finite_vector("sphere", "centre", &center)?;
+        // (the centre is checked there)
         let normal = Vector3::new(0.0, 0.0, if center.z > 0.0 { -1.0 } else { 1.0 });
         Self::with_pole(center, radius, normal)
     }

@@ -71,6 +71,21 @@ struct Setup {
     tolerances: (f64, f64, usize),
 }
 
+impl Setup {
+    /// This rank's rows of a full-length vector in stamp's order into `b`.
+    fn load(&mut self, v: &[f64]) -> std::result::Result<(), PetscError> {
+        let own = &self.own;
+        self.b.with_local_mut(|x| x.iter_mut().zip(own).for_each(|(x, &i)| *x = v[i]))
+    }
+
+    /// `x` gathered from every rank into a full-length vector in stamp's order.
+    fn unload(&mut self, v: &mut [f64]) -> std::result::Result<(), PetscError> {
+        self.gather.gather(&self.x, &mut self.full)?;
+        v.iter_mut().zip(&self.perm).for_each(|(x, &k)| *x = self.full[k]);
+        Ok(())
+    }
+}
+
 /// stamp's linear solver on PETSc (see the module documentation).
 pub struct PetscSolver {
     petsc: Petsc,
@@ -365,11 +380,9 @@ impl PetscSolver {
         let t = Instant::now();
         let (base, atol, max_it) = s.tolerances;
         s.ksp.set_tolerances(rtol.max(base), atol, max_it)?;
-        let own = &s.own;
-        s.b.with_local_mut(|x| x.iter_mut().zip(own).for_each(|(x, &i)| *x = b[i]))?;
+        s.load(b)?;
         let report = s.ksp.solve(&s.b, &mut s.x)?;
-        s.gather.gather(&s.x, &mut s.full)?;
-        b.iter_mut().zip(&s.perm).for_each(|(x, &k)| *x = s.full[k]);
+        s.unload(b)?;
         self.iterations += report.iterations;
         self.timings.solve += t.elapsed().as_secs_f64();
         self.timings.solves += 1;
@@ -381,6 +394,12 @@ impl PetscSolver {
 }
 
 impl PetscSolver {
+    /// `f` after a successful factorisation (an error otherwise), agreed over the ranks.
+    fn when_factored<T>(&mut self, f: impl FnOnce(&mut Self) -> std::result::Result<T, PetscError>) -> Result<T> {
+        let r = if self.factored { f(self) } else { Err(PetscError::new("solve called without a successful factorisation")) };
+        self.agree(r)
+    }
+
     fn compliance_local(&mut self, a: &[Vec<(usize, f64)>], b: &[Vec<(usize, f64)>]) -> std::result::Result<nalgebra::DMatrix<f64>, PetscError> {
         let s = self.setup.as_mut().ok_or_else(|| PetscError::new("solve called without a successful factorisation"))?;
         let n = s.key.0;
@@ -458,11 +477,9 @@ impl PetscSolver {
         }
         let t = Instant::now();
         for col in b.chunks_mut(n) {
-            let own = &s.own;
-            s.b.with_local_mut(|x| x.iter_mut().zip(own).for_each(|(x, &i)| *x = col[i]))?;
+            s.load(col)?;
             s.ksp.apply_preconditioner(&s.b, &mut s.x)?;
-            s.gather.gather(&s.x, &mut s.full)?;
-            col.iter_mut().zip(&s.perm).for_each(|(x, &k)| *x = s.full[k]);
+            s.unload(col)?;
         }
         self.timings.solve += t.elapsed().as_secs_f64();
         if b.iter().any(|x| !x.is_finite()) {
@@ -500,8 +517,7 @@ impl LinearSolver for PetscSolver {
     }
 
     fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
-        let r = if self.factored { self.solve_local(b, rtol) } else { Err(PetscError::new("solve called without a successful factorisation")) };
-        self.agree(r)
+        self.when_factored(|s| s.solve_local(b, rtol))
     }
 
     /// Selected entries of the inverse of MUMPS's factor (of P by default): the entries on the
@@ -512,15 +528,13 @@ impl LinearSolver for PetscSolver {
         if !mumps {
             return Ok(None);
         }
-        let r = if self.factored { self.compliance_local(a, b) } else { Err(PetscError::new("solve called without a successful factorisation")) };
-        self.agree(r).map(Some)
+        self.when_factored(|s| s.compliance_local(a, b)).map(Some)
     }
 
     /// Each column by the preconditioner alone (MUMPS's factor of P by default), as
     /// `LdltGmres` does with its own: the estimates of the contact points' compliance.
     fn solve_many_approx(&mut self, b: &mut [f64], ncols: usize) -> Result<()> {
-        let r = if self.factored { self.precondition_local(b, ncols) } else { Err(PetscError::new("solve called without a successful factorisation")) };
-        self.agree(r)
+        self.when_factored(|s| s.precondition_local(b, ncols))
     }
 
     fn timings(&self) -> SolverTimings {

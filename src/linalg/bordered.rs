@@ -76,6 +76,11 @@ impl<S: LinearSolver> BorderedSolver<S> {
         Ok(self.schur_inverse.clone().expect("built above"))
     }
 
+    /// The vectors' leading parts (their entries in the leading block).
+    fn leading(&self, v: &[Vec<(usize, f64)>]) -> Vec<Vec<(usize, f64)>> {
+        v.iter().map(|g| g.iter().copied().filter(|&(e, _)| e < self.n0).collect()).collect()
+    }
+
     /// The border's sides of a vector g = (g1, g2) in b^T K^-1 c: (g1 . Y - g2, z^T g1 - g2).
     fn border_sides(&self, g: &[(usize, f64)]) -> (Vec<f64>, Vec<f64>) {
         let (n0, m) = (self.n0, self.border);
@@ -317,9 +322,7 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         if self.border == 0 {
             return self.inner.forward_columns(b);
         }
-        let n0 = self.n0;
-        let lead: Vec<Vec<(usize, f64)>> = b.iter().map(|g| g.iter().copied().filter(|&(e, _)| e < n0).collect()).collect();
-        let Some(columns) = self.inner.forward_columns(&lead)? else { return Ok(None) };
+        let Some(columns) = self.inner.forward_columns(&self.leading(b))? else { return Ok(None) };
         let inverse = self.border_inverse()?;
         let out = columns
             .into_iter()
@@ -338,9 +341,8 @@ impl<S: LinearSolver> LinearSolver for BorderedSolver<S> {
         if self.border == 0 {
             return self.inner.compliance(a, b);
         }
-        let n0 = self.n0;
-        let lead = |v: &[Vec<(usize, f64)>]| -> Vec<Vec<(usize, f64)>> { v.iter().map(|g| g.iter().copied().filter(|&(e, _)| e < n0).collect()).collect() };
-        let Some(mut c) = self.inner.compliance(&lead(a), &lead(b))? else { return Ok(None) };
+        let (la, lb) = (self.leading(a), self.leading(b));
+        let Some(mut c) = self.inner.compliance(&la, &lb)? else { return Ok(None) };
         let inverse = self.border_inverse()?;
         let right: Vec<nalgebra::DVector<f64>> = b.iter().map(|g| inverse.as_ref() * nalgebra::DVector::from_vec(self.border_sides(g).1)).collect();
         for (i, g) in a.iter().enumerate() {
@@ -375,14 +377,20 @@ mod tests {
         solver.factorize(a.as_ref()).unwrap();
         let vectors: Vec<Vec<(usize, f64)>> = vec![vec![(n0 / 2, 1.0), (n0 / 2 + 1, -0.5), (n0, 0.7)], vec![(12, 2.0)], vec![(n0 - 3, 1.0), (n0 / 3, 0.25), (n0, -1.0)]];
         let columns = solver.forward_columns(&vectors).unwrap().expect("forward columns through the border");
-        for (j, bj) in vectors.iter().enumerate() {
-            let mut x = vec![0.0; n0 + 1];
+        let got = DMatrix::from_fn(vectors.len(), vectors.len(), |i, j| columns[i].dot(&columns[j]));
+        assert_whole_compliance(&mut solver, &vectors, &vectors, &got);
+    }
+
+    /// `got` against a_i^T K^-1 b_j from whole solves with `solver`, to 1e-10 relative.
+    fn assert_whole_compliance<S: LinearSolver>(solver: &mut BorderedSolver<S>, a: &[Vec<(usize, f64)>], b: &[Vec<(usize, f64)>], got: &DMatrix<f64>) {
+        let n = solver.n0 + solver.border;
+        for (j, bj) in b.iter().enumerate() {
+            let mut x = vec![0.0; n];
             bj.iter().for_each(|&(e, v)| x[e] += v);
             solver.solve_in_place(&mut x).unwrap();
-            for (i, bi) in vectors.iter().enumerate() {
-                let expected: f64 = bi.iter().map(|&(e, c)| c * x[e]).sum();
-                let got = columns[i].dot(&columns[j]);
-                assert!((got - expected).abs() <= 1e-10 * expected.abs().max(1e-3), "b{i}^T K^-1 b{j}: {got} against {expected}");
+            for (i, ai) in a.iter().enumerate() {
+                let expected: f64 = ai.iter().map(|&(e, v)| v * x[e]).sum();
+                assert!((got[(i, j)] - expected).abs() <= 1e-10 * expected.abs().max(1e-3), "a{i}^T K^-1 b{j}: {} against {expected}", got[(i, j)]);
             }
         }
     }
@@ -453,14 +461,6 @@ mod tests {
         let va: Vec<Vec<(usize, f64)>> = vec![vec![(n0 / 2, 1.0), (n0 / 2 + 1, -0.5), (n0, 0.7)], vec![(12, 2.0)]];
         let vb: Vec<Vec<(usize, f64)>> = vec![vec![(n0 - 3, 1.0), (n0 / 3, 0.25), (n0, -1.0)], vec![(n0 / 2, 0.5)], vec![(n0, 1.0)]];
         let c = solver.compliance(&va, &vb).unwrap().expect("the inner solver's compliance through the border");
-        for (j, bj) in vb.iter().enumerate() {
-            let mut x = vec![0.0; n0 + 1];
-            bj.iter().for_each(|&(e, v)| x[e] += v);
-            solver.solve_in_place(&mut x).unwrap();
-            for (i, ai) in va.iter().enumerate() {
-                let expected: f64 = ai.iter().map(|&(e, v)| v * x[e]).sum();
-                assert!((c[(i, j)] - expected).abs() <= 1e-10 * expected.abs().max(1e-3), "a{i}^T K^-1 b{j}: {} against {expected}", c[(i, j)]);
-            }
-        }
+        assert_whole_compliance(&mut solver, &va, &vb, &c);
     }
 }
