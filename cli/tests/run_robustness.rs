@@ -299,10 +299,13 @@ fn a_model_beyond_the_address_space_limit_is_refused_before_the_solve() {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("mesh.rectangle") && err.contains("ulimit -v") && err.contains("0.37 GiB") && !err.contains("allocation"), "{err}");
     assert!(!out.join("summary.json").exists(), "refused before anything is written");
-    // the same limit with enough room: solved
+    // a limit with room for the shipped 10 x 10 plate (0.06 GiB beside the 0.5 GiB of stacks and
+    // heaps): solved. A dense kernel that reserves twice the L3 cache per thread (faer's "std"
+    // feature, private-gemm-x86) aborted here on a CPU reporting 260 MiB of L3, and under 700 MiB
+    // on one reporting 480 MiB
     let small = variant("ulimit-small", "sphere-ss-displacement.toml", &[]);
     let out = small.parent().unwrap().join("out");
-    let o = under_ulimit_v(700 * 1024, &["run".as_ref(), "-q".as_ref(), "--out".as_ref(), out.as_os_str(), small.as_os_str()]);
+    let o = under_ulimit_v(600 * 1024, &["run".as_ref(), "-q".as_ref(), "--out".as_ref(), out.as_os_str(), small.as_os_str()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
