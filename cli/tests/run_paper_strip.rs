@@ -46,7 +46,7 @@ fn paper_r100_reproduces_table2_last_row() {
     let pr = vec3(&last["punches"]["cylinder"]["reaction"]);
     assert_eq!(pr, r);
 
-    // loaded zone on the half plate: [0, 90] in x2 (one node inside the paper's 92.5: docs/verification.md)
+    // loaded zone on the half plate: [0, 90] in x2 (one node inside the paper's 92.5: docs/verification/paper.md)
     let zone = &last["loaded_zone"];
     let (lo, hi) = (vec3(&zone["min"]), vec3(&zone["max"]));
     assert!(lo[1].abs() < 1e-9 && (hi[1] - 90.0).abs() < 1e-9, "loaded zone {lo:?} .. {hi:?}");
