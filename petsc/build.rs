@@ -156,11 +156,21 @@ fn main() {
             // types of the binding as stand-ins, and a compile error for any real build (lib.rs)
             println!("cargo:warning=stamp-petsc: {e}");
             println!("cargo:rustc-cfg=petsc_missing");
+            // probe again at the next build: PETSc may have been installed since (a path that
+            // does not exist makes cargo rerun this script every time, until PETSc is found)
+            println!("cargo:rerun-if-changed=petsc-not-found-probe-again");
             let out = PathBuf::from(env::var("OUT_DIR").unwrap());
             std::fs::write(out.join("bindings.rs"), STAND_INS).expect("write bindings.rs");
             return;
         }
     };
+    // and again when the PETSc.pc that was found changes (another PETSc installed over it)
+    if let Ok(o) = Command::new("pkg-config").args(["--variable=pcfiledir", "PETSc"]).output() {
+        let dir = String::from_utf8_lossy(&o.stdout).trim().to_string();
+        if o.status.success() && !dir.is_empty() {
+            println!("cargo:rerun-if-changed={dir}/PETSc.pc");
+        }
+    }
     let mut includes = petsc.include_paths.clone();
     includes.extend(probe_mpi());
 
