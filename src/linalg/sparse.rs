@@ -17,8 +17,10 @@ pub struct SparsePattern {
     /// For element e, `nodes_per_element^2` entries: offset of node a's rows inside the columns of
     /// node b, at index e * npe^2 + b * npe + a.
     block_start: Vec<u32>,
-    /// For every dof, the number of free components of its node that precede it.
-    rank: Vec<u8>,
+    /// For every dof, the number of free components of its node that precede it (u16: a plate of
+    /// 257 surfaces has 771 dofs per node; a u8 wrapped past 255 and slotted entries of two dofs
+    /// into one, which made plates of more than 85 surfaces "singular").
+    rank: Vec<u16>,
     nodes_per_element: usize,
 }
 
@@ -158,9 +160,12 @@ impl SparsePattern {
         // free components per node and rank of each dof inside its node
         let eqs = dofs.equations();
         let mut free = vec![0u32; nn];
-        let mut rank = vec![0u8; nn * dpn];
+        if dpn > u16::MAX as usize {
+            return Err(StampError::Problem(format!("{dpn} dofs per node is more than stamp can number (at most {})", u16::MAX)));
+        }
+        let mut rank = vec![0u16; nn * dpn];
         for n in 0..nn {
-            let mut r = 0u8;
+            let mut r = 0u16;
             for c in 0..dpn {
                 rank[n * dpn + c] = r;
                 if eqs[n * dpn + c] != PRESCRIBED {
@@ -420,6 +425,38 @@ mod tests {
         let all = SparsePattern::coupled_subset(&dofs, ne, 4, nodes, &[], &vec![true; ne]).unwrap();
         assert_eq!(entries(&all), entries(&SparsePattern::new(&dofs, ne, 4, nodes).unwrap()));
         assert!(SparsePattern::coupled_subset(&dofs, ne, 4, nodes, &[], &[true]).is_err());
+    }
+
+    /// Nodes of many dofs (a plate of 100 surfaces: 300 per node, some prescribed): every local
+    /// entry has a slot of its own holding its (row, column) (a rank kept in a u8 wrapped at 256).
+    #[test]
+    fn nodes_of_hundreds_of_dofs_get_a_slot_for_every_entry() {
+        let dpn = 300;
+        let mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 1.0, 2, 1).unwrap();
+        let mut dofs = DofMap::new(mesh.num_nodes(), dpn).unwrap();
+        dofs.fix(mesh.group_nodes("left").unwrap(), &[0, 7, 299]).unwrap();
+        let ne = mesh.num_cells();
+        let p = SparsePattern::new(&dofs, ne, 4, |e| mesh.cells[e].to_vec()).unwrap();
+        let (cp, ri) = (p.symbolic().col_ptr(), p.symbolic().row_idx());
+        let mut seen = std::collections::HashSet::new();
+        for e in 0..ne {
+            let en = mesh.cells[e];
+            for (b, &nb) in en.iter().enumerate() {
+                for cb in 0..dpn {
+                    let Some(col) = dofs.equation(dpn * nb + cb) else { continue };
+                    for (a, &na) in en.iter().enumerate() {
+                        for ca in 0..dpn {
+                            let row_dof = dpn * na + ca;
+                            let Some(row) = dofs.equation(row_dof) else { continue };
+                            let slot = p.slot(e, a, b, row_dof, col);
+                            assert!(slot >= cp[col] && slot < cp[col + 1] && ri[slot] == row, "element {e}: ({row}, {col}) at slot {slot}");
+                            seen.insert(slot);
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(seen.len(), p.nnz());
     }
 
     /// `unbordered` undoes `bordered`, element slots included.
