@@ -126,11 +126,11 @@ struct Summary {
     seconds: f64,
     point_arrays: Vec<String>,
     cell_arrays: Vec<String>,
-    /// `[solver] predictor = "coarse"`: what the coarse solve cost (see coarse.rs); absent
+    /// `[solver] predictor = "coarse"`: what the coarse solve cost (see model/coarse.rs); absent
     /// otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     coarse_predictor: Option<crate::model::coarse::CoarseReport>,
-    /// `stamp run --refine`: the meshes and the estimates (see refine.rs); absent otherwise.
+    /// `stamp run --refine`: the meshes and the estimates (see refine/mod.rs); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     refinement: Option<Value>,
     /// One entry per converged load step whose files were all written (the .pvd lists the same
