@@ -1,4 +1,7 @@
 //! From a parsed problem to a [`Model`]: section, plate elements, constraints, loads and punches.
+//! [`build_on`] calls a builder per table of the problem file, in turn: `build_plate` (`[plate]`
+//! and `[[material]]`), `build_boundary` (`[[boundary]]`), `build_loads` (`[[load]]`),
+//! `build_punches` (`[[punch]]`) and `build_solver` (`[solver]`).
 //!
 //! Conventions:
 //! * Constraints: `fix` holds components at zero, `prescribe` sets them to value * load factor; the
@@ -241,12 +244,35 @@ fn build_coarse(p: &Problem, fine: &MeshData) -> Result<CoarseSetup> {
 }
 
 /// Build everything the solve needs on the given mesh (the problem's own, or its refinement: the
-/// caller has checked that it fits in memory).
+/// caller has checked that it fits in memory): the builders of the problem file's tables in turn,
+/// `[plate]` (with `[[material]]`), `[[boundary]]`, `[[load]]`, `[[punch]]` and `[solver]`.
 pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
-    let s = &p.spec;
-    let n_nodes = mesh.mesh.num_nodes();
+    let PlateBuild { plate, section, young, kinematics } = build_plate(p, &mesh)?;
+    let layout = Layout::of(&plate);
+    let dofs = build_boundary(p, &mesh, &layout)?;
+    let mut model = Model::new(plate, dofs).map_err(|e| match e {
+        e @ StampError::Mesh(_) => mesh_error(p, &mesh, e),
+        e => StampError::Input { file: p.path.display().to_string(), message: e.to_string() },
+    })?;
+    build_loads(p, &mesh, &section, &layout, &mut model)?;
+    let punches = build_punches(p, &mesh, &section, young, kinematics, &layout, &mut model)?;
+    let settings = build_solver(p, &mut model)?;
+    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, coarse: None })
+}
 
-    // plate
+/// The plate of `[plate]` (with the `[[material]]` tables of its layers): its elements, the
+/// section (the plate's, or the laminate's faces with a modulus standing for it: the geometry the
+/// loads and punches use), that modulus and the kinematics.
+struct PlateBuild {
+    plate: Plate,
+    section: Section,
+    young: f64,
+    kinematics: Kinematics,
+}
+
+/// `[plate]` and `[[material]]`: the section, the laminate and the plate elements on the mesh.
+fn build_plate(p: &Problem, mesh: &MeshData) -> Result<PlateBuild> {
+    let s = &p.spec;
     let ps = s.plate.get_ref();
     let kin = match ps.kinematics {
         KinematicsSpec::Nonlinear => Kinematics::Nonlinear,
@@ -291,10 +317,16 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         Some((lam, per_layer)) => Plate::layered(per_layer, &mesh.mesh, lam, kin),
         None => Plate::new(surfaces, &mesh.mesh, section.clone(), kin),
     }
-    .map_err(|e| mesh_error(p, &mesh, e))?;
-    let layout = Layout::of(&plate);
+    .map_err(|e| mesh_error(p, mesh, e))?;
+    Ok(PlateBuild { plate, section, young, kinematics: kin })
+}
 
-    // constraints
+/// `[[boundary]]` (and `[plate] plane_strain`): the components held at zero or prescribed, by
+/// group.
+fn build_boundary(p: &Problem, mesh: &MeshData, layout: &Layout) -> Result<DofMap> {
+    let s = &p.spec;
+    let ps = s.plate.get_ref();
+    let n_nodes = mesh.mesh.num_nodes();
     let mut dofs = DofMap::new(n_nodes, layout.dofs_per_node)?;
     if ps.plane_strain {
         let all: Vec<usize> = (0..n_nodes).collect();
@@ -304,7 +336,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         let bs = b.get_ref();
         let key = format!("boundary[{i}].group");
         let name = bs.group.get_ref();
-        let nodes = mesh.nodes(name).ok_or_else(|| group_error(p, bs.group.span(), &key, name, "", &mesh))?;
+        let nodes = mesh.nodes(name).ok_or_else(|| group_error(p, bs.group.span(), &key, name, "", mesh))?;
         let comps: Vec<usize> = layout.fibre_components(&bs.fix.iter().flat_map(|d| d.components.clone()).collect::<Vec<_>>());
         dofs.fix(&nodes, &comps).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}]"), e))?;
         for (k, v) in &bs.prescribe {
@@ -316,12 +348,14 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
             }
         }
     }
-    let mut model = Model::new(plate, dofs).map_err(|e| match e {
-        e @ StampError::Mesh(_) => mesh_error(p, &mesh, e),
-        e => StampError::Input { file: p.path.display().to_string(), message: e.to_string() },
-    })?;
+    Ok(dofs)
+}
 
-    // loads
+/// `[[load]]`: line, surface, pressure, moment and point loads, as nodal forces of the model or
+/// follower loads.
+fn build_loads(p: &Problem, mesh: &MeshData, section: &Section, layout: &Layout, model: &mut Model<Plate>) -> Result<()> {
+    let s = &p.spec;
+    let n_nodes = mesh.mesh.num_nodes();
     for (i, l) in s.load.iter().enumerate() {
         let ls = l.get_ref();
         let key = format!("load[{i}].group");
@@ -329,19 +363,18 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         let face = ls.face.unwrap_or_default();
         match ls.kind {
             LoadKind::Line => {
-                let segs = mesh.curves.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "curve", &mesh))?;
+                let segs = mesh.curves.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "curve", mesh))?;
                 let f = ls.force.unwrap().0;
                 for s in segs {
-                    let (a, b) = (mesh.mesh.coords[s[0]], mesh.mesh.coords[s[1]]);
-                    let len = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                    let len = segment_length(mesh, s);
                     for &n in s {
-                        add_force(&mut model, &layout, n, f.map(|x| 0.5 * len * x), face)?;
+                        add_force(model, layout, n, f.map(|x| 0.5 * len * x), face)?;
                     }
                 }
             }
             LoadKind::Surface | LoadKind::Pressure => {
-                let cells = mesh.surfaces.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "surface", &mesh))?;
-                let size = model_size(&mesh, &section, None);
+                let cells = mesh.surfaces.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "surface", mesh))?;
+                let size = model_size(mesh, section, None);
                 if ls.kind == LoadKind::Pressure {
                     let spec = ls.pressure.as_ref().unwrap();
                     let q = crate::model::pressure::pressure_function(spec.get_ref(), size);
@@ -368,7 +401,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                     };
                     for (n, &fz) in nodal.iter().enumerate() {
                         if fz != 0.0 {
-                            add_force(&mut model, &layout, n, [0.0, 0.0, sign * fz], face)?;
+                            add_force(model, layout, n, [0.0, 0.0, sign * fz], face)?;
                         }
                     }
                     continue;
@@ -377,17 +410,16 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                 let w = mesh.nodal_areas_of(cells);
                 for (n, &a) in w.iter().enumerate() {
                     if a > 0.0 {
-                        add_force(&mut model, &layout, n, f.map(|x| a * x), face)?;
+                        add_force(model, layout, n, f.map(|x| a * x), face)?;
                     }
                 }
             }
             LoadKind::Moment => {
-                let segs = mesh.curves.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "curve", &mesh))?;
+                let segs = mesh.curves.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "curve", mesh))?;
                 let m = ls.moment.unwrap().0;
                 let mut share = vec![0.0; n_nodes];
                 for s in segs {
-                    let (a, b) = (mesh.mesh.coords[s[0]], mesh.mesh.coords[s[1]]);
-                    let len = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                    let len = segment_length(mesh, s);
                     for &n in s {
                         share[n] += 0.5 * len;
                     }
@@ -400,21 +432,33 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
                 } else {
                     for (n, mn) in couples {
                         let f = fixed_couple_force(mn, h);
-                        add_force(&mut model, &layout, n, f, LoadFace::Top)?;
-                        add_force(&mut model, &layout, n, f.map(|x| -x), LoadFace::Bottom)?;
+                        add_force(model, layout, n, f, LoadFace::Top)?;
+                        add_force(model, layout, n, f.map(|x| -x), LoadFace::Bottom)?;
                     }
                 }
             }
             LoadKind::Point => {
-                let nodes = mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "", &mesh))?;
+                let nodes = mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "", mesh))?;
                 for n in nodes {
-                    add_force(&mut model, &layout, n, ls.force.unwrap().0, face)?;
+                    add_force(model, layout, n, ls.force.unwrap().0, face)?;
                 }
             }
         }
     }
+    Ok(())
+}
 
-    // punches
+/// The length of a segment of a curve group, in the reference plane.
+fn segment_length(mesh: &MeshData, s: &[usize; 2]) -> f64 {
+    let (a, b) = (mesh.mesh.coords[s[0]], mesh.mesh.coords[s[1]]);
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+}
+
+/// `[[punch]]`: each punch's surface, candidate points, contact pair (eps_reg, motion or force)
+/// added to the model, and the model's penetration tolerance; what the outputs need of them.
+fn build_punches(p: &Problem, mesh: &MeshData, section: &Section, young: f64, kin: Kinematics, layout: &Layout, model: &mut Model<Plate>) -> Result<Vec<PunchInfo>> {
+    let s = &p.spec;
+    let n_nodes = mesh.mesh.num_nodes();
     let h = section.thickness();
     let le = mesh.element_size();
     let mut punches = Vec::new();
@@ -430,7 +474,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
             Shape::Plane => Arc::new(Plane::new(Vector3::from(spec.point.unwrap().0), Vector3::from(spec.normal.unwrap().0)).map_err(wrap)?),
             Shape::Expression => {
                 let psi = spec.psi.as_ref().unwrap();
-                Arc::new(Expression::new(psi.get_ref(), model_size(&mesh, &section, None)).map_err(|e| p.psi_error(psi, e.column, &format!("{key}.psi"), &e.message))?)
+                Arc::new(Expression::new(psi.get_ref(), model_size(mesh, section, None)).map_err(|e| p.psi_error(psi, e.column, &format!("{key}.psi"), &e.message))?)
             }
             Shape::Stl => Arc::new(stl_die(p, spec.file.as_ref().expect("checked: stl has file"), &key)?),
         };
@@ -443,7 +487,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
             None => ((0..n_nodes).collect::<Vec<_>>(), mesh.mesh.nodal_areas()),
             Some(g) => {
                 let gname = g.get_ref();
-                let nodes = mesh.nodes(gname).ok_or_else(|| group_error(p, g.span(), &format!("{key}.group"), gname, "", &mesh))?;
+                let nodes = mesh.nodes(gname).ok_or_else(|| group_error(p, g.span(), &format!("{key}.group"), gname, "", mesh))?;
                 let w = match mesh.surfaces.get(gname) {
                     Some(cells) => mesh.nodal_areas_of(cells),
                     None => mesh.mesh.nodal_areas(),
@@ -468,7 +512,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         };
         let mut pair = ContactPair::new(name.clone(), surface.clone(), points, 1.0, ck);
         if spec.contact.unwrap_or(DEFAULT_CONTACT) == ContactSpec::Integrated {
-            pair = integrated(pair, &mesh, spec.group.as_ref().map(|g| g.get_ref().as_str())).map_err(|e| p.error_at(pu.span(), &format!("{key}.contact"), e))?;
+            pair = integrated(pair, mesh, spec.group.as_ref().map(|g| g.get_ref().as_str())).map_err(|e| p.error_at(pu.span(), &format!("{key}.contact"), e))?;
             // the pattern couples the patches of the points within a thickness of the punch
             pair.coupling_reach = 0.02 * h;
         }
@@ -499,7 +543,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         if let Some(t) = &spec.penetration_tolerance {
             let tol = t.get_ref().0;
             // below the round-off of the model's size the penetration cannot be measured
-            let size = model_size(&mesh, &section, spec.radius.map(|r| r.0));
+            let size = model_size(mesh, section, spec.radius.map(|r| r.0));
             let floor = crate::schema::limits::MIN_PENETRATION_TOLERANCE * size;
             if tol < floor {
                 return Err(p.error_at(
@@ -513,9 +557,13 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         punches.push(PunchInfo { name, face, z, surface, eps_reg, eps_automatic });
     }
     model.augmented_tolerance = tolerance;
-    model.mixed_tangent = s.solver.newton.unwrap_or_default() == crate::schema::NewtonTangent::Mip;
+    Ok(punches)
+}
 
-    // solver
+/// `[solver]`: Newton's settings, and its tangent on the model.
+fn build_solver(p: &Problem, model: &mut Model<Plate>) -> Result<NewtonSettings> {
+    let s = &p.spec;
+    model.mixed_tangent = s.solver.newton.unwrap_or_default() == crate::schema::NewtonTangent::Mip;
     let sv = &s.solver;
     let mut settings = NewtonSettings { max_increment: DEFAULT_MAX_INCREMENT, ..NewtonSettings::default() };
     if let Some(x) = &sv.max_increment {
@@ -549,7 +597,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
         settings.resolve_contact = x;
     }
     settings.validate().map_err(|e| StampError::Input { file: p.path.display().to_string(), message: format!("[solver]: {e}") })?;
-    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, coarse: None })
+    Ok(settings)
 }
 
 /// The default of `[[punch]] contact` (see docs/design.md).
