@@ -51,14 +51,8 @@ pub fn join_refine_value<I: IntoIterator<Item = std::ffi::OsString>>(args: I) ->
     out
 }
 
-/// The subfolder of the output folder for refinement level `level` (1-based).
-pub fn level_folder(level: usize) -> String {
-    if level == 1 {
-        "refined".into()
-    } else {
-        format!("refined{level}")
-    }
-}
+/// The subfolder of the output folder for refinement level `level` (1-based): the level's name.
+pub use refine_report::level_name as level_folder;
 
 /// Ok if the problem's mesh refined 1 ..= levels times fits in `available` bytes (None: unknown)
 /// with `dofs_per_node` unknowns per node; else what the largest that fits is and what to do.

@@ -88,8 +88,9 @@ pub fn match_rows(coarse: &History, fine: &History) -> Vec<Option<usize>> {
         .collect()
 }
 
-/// The name of refinement level `level` (1-based) in column names: "refined", "refined2", ...
-fn level_name(level: usize) -> String {
+/// The name of refinement level `level` (1-based): "refined", "refined2", ..., in column names and
+/// as the level's folder inside the output folder ([`crate::refine::level_folder`]).
+pub fn level_name(level: usize) -> String {
     if level == 1 {
         "refined".into()
     } else {

@@ -18,19 +18,25 @@ pub struct ProbeSpec {
     pub points: Option<usize>,
 }
 
+/// A probe's `name` (it names files): 1 to 64 letters, digits, '_' or '-', and no other probe of
+/// its kind (`what`: "probes", "thickness probes") named alike.
+fn check_probe_name(p: &Problem, span: std::ops::Range<usize>, key: &str, name: &str, names: &mut std::collections::BTreeSet<String>, what: &str) -> Result<()> {
+    if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Err(p.error_at(span, &format!("{key}.name"), format!("{} must be 1 to 64 letters, digits, '_' or '-' (it names files)", stamp::quote(name))));
+    }
+    if !names.insert(name.to_string()) {
+        return Err(p.error_at(span, &format!("{key}.name"), format!("two {what} are named {}", stamp::quote(name))));
+    }
+    Ok(())
+}
+
 /// Check the probes of a problem file (called by [`Problem::parse`]; see outputs/probe.rs) (names, ends, number of points), with file, line and key.
 pub fn check_probes(p: &Problem, probes: &[Spanned<ProbeSpec>]) -> Result<()> {
     let mut names = std::collections::BTreeSet::new();
     for (i, s) in probes.iter().enumerate() {
         let spec = s.get_ref();
         let key = format!("output.probe[{i}]");
-        let name = &spec.name;
-        if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("{} must be 1 to 64 letters, digits, '_' or '-' (it names files)", stamp::quote(name))));
-        }
-        if !names.insert(name.clone()) {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("two probes are named {}", stamp::quote(name))));
-        }
+        check_probe_name(p, s.span(), &key, &spec.name, &mut names, "probes")?;
         if spec.from.iter().chain(&spec.to).any(|v| !v.is_finite()) {
             return Err(p.error_at(s.span(), &key, format!("from = {:?} and to = {:?} must be finite", spec.from, spec.to)));
         }
@@ -77,13 +83,7 @@ pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>
                 "the stresses through the thickness are those of the 3D law: the plate needs `layers` or `surfaces` = 3 to 5 (the two-surface plate has the paper's plane-stress law)",
             ));
         }
-        let name = &spec.name;
-        if name.is_empty() || name.len() > 64 || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("{} must be 1 to 64 letters, digits, '_' or '-' (it names files)", stamp::quote(name))));
-        }
-        if !names.insert(name.clone()) {
-            return Err(p.error_at(s.span(), &format!("{key}.name"), format!("two thickness probes are named {}", stamp::quote(name))));
-        }
+        check_probe_name(p, s.span(), &key, &spec.name, &mut names, "thickness probes")?;
         if spec.at.iter().any(|v| !v.is_finite()) {
             return Err(p.error_at(s.span(), &format!("{key}.at"), format!("must be two finite numbers, got {:?}", spec.at)));
         }

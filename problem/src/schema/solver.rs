@@ -145,7 +145,7 @@ impl Problem {
             return Err(fail(span_of(&sv.min_increment), "solver.min_increment", format!("{} exceeds max_increment = {}", num(min_inc), num(max_inc))));
         }
         let targets = self.targets();
-        let path: f64 = targets.iter().fold((0.0, 0.0), |(len, last): (f64, f64), &t| (len + (t - last).abs(), t)).0;
+        let path = path_length(&targets);
         let increments = path / max_inc;
         if increments > limits::MAX_STEPS as f64 {
             return Err(fail(
@@ -173,7 +173,7 @@ impl Problem {
     pub fn least_steps(&self) -> usize {
         let max_inc = self.spec.solver.max_increment.as_ref().map_or(DEFAULT_MAX_INCREMENT, |x| x.get_ref().0);
         let targets = self.targets();
-        let path: f64 = targets.iter().fold((0.0, 0.0), |(len, last): (f64, f64), &t| (len + (t - last).abs(), t)).0;
+        let path = path_length(&targets);
         // bounded by limits::MAX_STEPS (check_increments)
         let increments = (path / max_inc * (1.0 - 1e-12)).ceil().min(limits::MAX_STEPS as f64) as usize;
         increments.max(targets.len())
@@ -202,4 +202,9 @@ impl Problem {
         }
     }
 
+}
+
+/// The length of the load path through `targets` from 0 (down again counts too).
+fn path_length(targets: &[f64]) -> f64 {
+    targets.iter().fold((0.0, 0.0), |(len, last): (f64, f64), &t| (len + (t - last).abs(), t)).0
 }
