@@ -149,7 +149,8 @@ mod tests {
                             break;
                         }
                     }
-                    let named = segments.len();
+                    // a name followed by `::` is a module's (a macro's is followed by `!`)
+                    let a_path = segments.first().is_some_and(|s| rest[s.len()..].starts_with("::"));
                     let mut found = None;
                     for s in segments {
                         base.push(s);
@@ -162,8 +163,8 @@ mod tests {
                             deps.insert(dep);
                         }
                         Some(_) => {}
-                        None if named > 1 => unresolved.push(format!("{name}: {line}")),
-                        None => {} // a name of the crate root: the macros out! and outln!
+                        None if a_path => unresolved.push(format!("{name}: {line}")),
+                        None => {} // an item of the crate root (the macros out! and outln!) or of `super`
                     }
                 }
             }

@@ -2,8 +2,8 @@
 //! thousands of times longer than wide (a 20 x 1e6 rectangle of 20 x 20 cells crawled on in
 //! increments of 1e-4 of the load), so `stamp check` and `stamp run` say so before the solve.
 
-use crate::model::mesh::where_node;
 use crate::model::mesh::MeshData;
+use crate::model::mesh::where_node;
 use crate::schema::Problem;
 
 /// Aspect ratios above this are warned about.

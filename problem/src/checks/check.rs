@@ -28,12 +28,12 @@
 //! ([`crate::checks::cell_shape`]); after a run, a punch that never touched the plate or touched it on a
 //! zone narrower than the cells ([`after_the_run`]).
 
-use crate::model::build::Setup;
-use crate::model::mesh::{where_node, MeshData};
-use crate::schema::{LoadFace, LoadKind, PlotAxis, Problem};
 use crate::checks::punch_start::{first_gap, gap_at, start_gaps, PointGap};
 use crate::checks::rigid_modes::{direction_words, join_and, num, RigidModes};
 use crate::checks::travel_modes::TravelModes;
+use crate::model::build::Setup;
+use crate::model::mesh::{where_node, MeshData};
+use crate::schema::{LoadFace, LoadKind, PlotAxis, Problem};
 use nalgebra::Vector3;
 use stamp::dofs::PRESCRIBED;
 use stamp::nonlinear::NonlinearProblem;

@@ -18,12 +18,12 @@
 //!   the run when the punch reaches the plate's far face (the other face than its contact face)
 //!   there, with the plate at both ends, but not at the step's ends.
 
+use crate::checks::rigid_modes::num;
 use crate::model::build::Setup;
-use crate::model::mesh::where_node;
 use crate::model::mesh::MeshData;
+use crate::model::mesh::where_node;
 use crate::model::plate_model::Layout;
 use crate::schema::{Problem, Shape};
-use crate::checks::rigid_modes::num;
 use nalgebra::Vector3;
 use stamp::contact::{ContactPair, PunchMotion};
 use stamp::{quote, Result, StampError};

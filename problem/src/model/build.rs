@@ -33,8 +33,8 @@
 //!   `direction` is then an unknown, reported per step in summary.json. It may start off the plate:
 //!   while nothing touches, the closest point pulls it down (see `ContactPair::evaluate`).
 
-use crate::model::mesh::{group_error, MeshData};
 use crate::checks::rigid_modes::num;
+use crate::model::mesh::{group_error, MeshData};
 use crate::model::plate_model::{Layout, Plate};
 use crate::schema::{ContactKinematicsSpec, ContactSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape, DEFAULT_MAX_INCREMENT};
 use nalgebra::Vector3;

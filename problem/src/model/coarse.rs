@@ -8,10 +8,10 @@
 
 use crate::model::build::{CoarseSetup, Setup};
 use serde::Serialize;
-use stamp::mesh::coarse_path::CoarsePath;
 use stamp::linalg::bordered::BorderedSolver;
-use stamp::mesh::transfer::Prolongation;
 use stamp::mesh::QuadMesh;
+use stamp::mesh::coarse_path::CoarsePath;
+use stamp::mesh::transfer::Prolongation;
 use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};
 use std::sync::Arc;
 use std::time::Instant;

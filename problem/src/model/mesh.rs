@@ -5,9 +5,9 @@
 //! group `all`, and the point groups `corner_ll` (a, c), `corner_lr` (b, c), `corner_ur` (b, d),
 //! `corner_ul` (a, d) and, when nx and ny are even, `center`.
 
+use crate::checks::rigid_modes::num;
 use crate::model::memory::check_model_fits;
 use crate::schema::Problem;
-use crate::checks::rigid_modes::num;
 use stamp::io::read_msh;
 use stamp::mesh::QuadMesh;
 use stamp::{Result, StampError};

@@ -4,12 +4,12 @@
 //! one [`Element`] for the rest of the run, with where each keeps its surfaces' displacements
 //! among the unknowns ([`Layout`]).
 
+use stamp::Result;
 use stamp::element::{Element, LocalSystem};
 use stamp::mesh::QuadMesh;
-use stamp::Result;
+use stamp_elements::laminate::LaminateWorkspace;
 use stamp_elements::multi_surface::{lagrange, surface_zetas, MultiSurfaceWorkspace, Resultants};
 use stamp_elements::plate::PlateWorkspace;
-use stamp_elements::laminate::LaminateWorkspace;
 use stamp_elements::{
     FiveSurfaceLaminate, FiveSurfacePlate, FourSurfaceLaminate, FourSurfacePlate, Kinematics, Laminate, Ply, PlyMaterial, PlateElements, Section, ThreeSurfaceLaminate, ThreeSurfacePlate,
 };

@@ -3,8 +3,8 @@
 //! positions of the Gauss points and turned into consistent nodal forces int N_a q dA.
 
 use crate::schema::{PressureSpec, Problem};
-use stamp::mesh::{bilinear, bilinear_jacobian, QuadMesh};
 use stamp::Result;
+use stamp::mesh::{bilinear, bilinear_jacobian, QuadMesh};
 
 /// The Gauss points of the 2 x 2 rule.
 const G: f64 = 0.577_350_269_189_625_8;

@@ -11,12 +11,12 @@
 //! * contact area: the sum of the tributary areas (contact weights) of the active nodes;
 //! * max pressure: the largest q_n; max penetration: the largest max(0, -Psi / |grad Psi|).
 
+use crate::model::plate_model::Layout;
 use crate::outputs::plot::{write_plot, Plot, Series};
 use crate::schema::units::Units;
+use stamp::Result;
 use stamp::contact::ContactPair;
 use stamp::io::write_string_atomically;
-use stamp::Result;
-use crate::model::plate_model::Layout;
 use stamp_elements::Face;
 use std::path::{Path, PathBuf};
 

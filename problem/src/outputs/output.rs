@@ -21,12 +21,12 @@
 
 use crate::model::build::PunchInfo;
 use crate::model::mesh::MeshData;
+use crate::model::plate_model::{Layout, Plate};
 use nalgebra::Vector3;
 use serde::Serialize;
 use stamp::element::Element;
 use stamp::io::Field;
 use stamp::model::Model;
-use crate::model::plate_model::{Layout, Plate};
 use stamp_elements::{Face, Section};
 use std::collections::BTreeMap;
 

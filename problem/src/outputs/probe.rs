@@ -31,16 +31,16 @@
 //! point: the active node of the first written step closest to the pressure-weighted centre of its
 //! active nodes, or, when nothing touches yet, the node closest to the punch.
 
-use crate::outputs::history::{sig4, History, HistoryRow};
-use crate::model::plate_model::Layout;
 use crate::model::mesh::MeshData;
+use crate::model::plate_model::Layout;
+use crate::outputs::history::{sig4, History, HistoryRow};
 use crate::outputs::plot::{write_plot, Plot, Series};
-use crate::schema::{Problem, ProbeSpec};
 use crate::schema::units::Units;
+use crate::schema::{Problem, ProbeSpec};
+use stamp::Result;
 use stamp::contact::ContactPair;
 use stamp::io::write_string_atomically;
 use stamp::mesh::{bilinear, inverse_bilinear, QuadMesh};
-use stamp::Result;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 

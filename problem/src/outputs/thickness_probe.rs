@@ -16,9 +16,9 @@
 //! transverse stresses of the two layers differ by what the model has not converged
 //! (docs/verification.md measures it against Pagano's exact solution).
 
-use crate::outputs::equilibrium_shear::ShearRecovery;
 use crate::model::mesh::MeshData;
 use crate::model::plate_model::Plate;
+use crate::outputs::equilibrium_shear::ShearRecovery;
 use crate::outputs::probe::CellLocator;
 use crate::schema::{Problem, DEFAULT_POINTS_PER_LAYER};
 use stamp::element::Element;

@@ -17,11 +17,11 @@ pub mod refine_report;
 pub mod richardson;
 
 use crate::model::build::{build, build_on};
-use crate::model::mesh::MeshData;
-use crate::schema::Problem;
-use crate::refine::refine_report::{quantities, times, Report};
 use crate::model::coarse::PreviousLevel;
+use crate::model::mesh::MeshData;
+use crate::refine::refine_report::{quantities, times, Report};
 use crate::run::solve::{default_out_dir, solve_and_write, RunOutcome, SolveOptions};
+use crate::schema::Problem;
 use crate::schema::units::Units;
 use serde_json::{json, Value};
 use stamp::io::write_string_atomically;

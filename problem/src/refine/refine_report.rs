@@ -13,8 +13,8 @@
 //! with two levels or more `q_order` (the order used).
 
 use crate::outputs::history::{sig, History, HistoryRow};
-use crate::refine::richardson::{extrapolate, Estimate, ASSUMED_ORDER};
 use crate::outputs::table::{column, render_columns, step_columns};
+use crate::refine::richardson::{extrapolate, Estimate, ASSUMED_ORDER};
 use crate::schema::units::Units;
 use serde_json::{json, Map, Value};
 

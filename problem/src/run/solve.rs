@@ -2,15 +2,15 @@
 //! every converged step written as soon as it converges (so a failure keeps what converged).
 
 use crate::model::build::Setup;
-use crate::outputs::output::{contact_csv, step_data, Context};
-use crate::outputs::history::History;
 use crate::model::plate_model::Layout;
-use serde_json::Value;
+use crate::outputs::history::History;
+use crate::outputs::output::{contact_csv, step_data, Context};
 use crate::outputs::probe::Probes;
-use crate::schema::{PlotAxis, Problem};
 use crate::schema::units::Units;
+use crate::schema::{PlotAxis, Problem};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
+use serde_json::Value;
 use stamp::io::{write_pvd, write_string_atomically, write_vtu};
 use stamp::linalg::bordered::BorderedSolver;
 use stamp::nonlinear::{NewtonRaphson, NonlinearProblem, NonlinearSolver};

@@ -2,10 +2,10 @@
 //! by the constraint words.
 
 use super::Problem;
-use stamp::Result;
 use super::values::Finite;
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use stamp::Result;
 use stamp::quote;
 use std::collections::BTreeMap;
 use toml::Spanned;

@@ -3,11 +3,11 @@
 //! crate::model::pressure).
 
 use super::Problem;
-use stamp::Result;
 use super::limits;
 use super::values::{num, Vec3};
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use stamp::Result;
 use toml::Spanned;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

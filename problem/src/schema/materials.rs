@@ -1,8 +1,8 @@
 //! `[[material]]`: the materials of a laminate's layers and the entries of `[plate] layers`
 //! (turned into a laminate by crate::model::laminate_spec).
 
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
 
 /// A number or three numbers, as written.
 #[derive(Debug, Clone, PartialEq)]

@@ -2,12 +2,12 @@
 //! `coarse_file` of the coarse predictor; the mesh itself is built by crate::model::mesh.
 
 use super::Problem;
-use super::solver::Predictor;
-use stamp::Result;
 use super::limits;
+use super::solver::Predictor;
 use super::values::{num, vec_text, AnyNumber};
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use stamp::Result;
 use toml::Spanned;
 
 #[derive(Debug, Deserialize)]

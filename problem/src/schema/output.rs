@@ -1,8 +1,8 @@
 //! `[output]`: which files a run writes, the plot's axis and group, the loaded-zone threshold,
 //! and the probes (`[[output.probe]]`, `[[output.thickness_probe]]`).
 
-use super::values::Fraction;
 use super::Problem;
+use super::values::Fraction;
 use serde::Deserialize;
 use stamp::{Result, StampError};
 use toml::Spanned;

@@ -2,11 +2,11 @@
 //! `layers`, the kinematics and the surfaces through the thickness.
 
 use super::Problem;
-use stamp::Result;
 use super::materials::LayerSpec;
 use super::values::{Finite, Poisson, Positive};
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use stamp::Result;
 use toml::Spanned;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]

@@ -2,11 +2,11 @@
 //! settings.
 
 use super::Problem;
-use stamp::{quote, Result};
 use super::limits;
 use super::values::{vec_text, Finite, Positive, Vec3};
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use stamp::{quote, Result};
 use toml::Spanned;
 
 /// A punch's prescribed motion: `[d1, d2, d3]` (the displacement at load factor 1, times the load

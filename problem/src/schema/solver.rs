@@ -2,11 +2,11 @@
 //! the linear solver's options.
 
 use super::Problem;
-use stamp::{Result, StampError};
 use super::limits;
 use super::values::{num, CutbackCount, CycleCount, Increment, InitialIncrement, IterationCount, LineSearchCount, MaxStepCount, NonNegative, RelTol, StepCount};
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use stamp::{Result, StampError};
 use toml::Spanned;
 
 /// Load factors to reach in turn: finite, >= 0, each different from the one before (the path starts

@@ -11,8 +11,8 @@
 //! table, the CSV headers stay plain, and every plot axis says its unit. Without the table the labels
 //! say "length", "force" and "force/length^2".
 
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
 
 /// A unit name: 1 to 20 printable characters (no control characters), e.g. "mm", "kN", "N/mm^2".
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -3,8 +3,8 @@
 //! message shows a number.
 
 use super::limits;
-use serde::de::{Deserializer, Error as _};
 use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
 
 /// A number as a message shows it: plain decimals for ordinary sizes, `{:e}` for tiny or huge ones
 /// (so that 1e300 is not printed with 300 digits and 1e-200 does not show as 0).
