@@ -1,5 +1,5 @@
 //! A square plate pressed at its centre by a rigid sphere, built through the library API the way
-//! the CLI builds it (problem/src/build.rs): a mesh, PlateElements, a DofMap with the supports, a
+//! the CLI builds it (problem/src/model/build.rs): a mesh, PlateElements, a DofMap with the supports, a
 //! ContactPair of the top-face nodes with a Sphere, solved by NewtonRaphson + SparseLu along a load
 //! path. Used by the verification tests (`tests/verify_*.rs`).
 //!

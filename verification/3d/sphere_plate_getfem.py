@@ -16,7 +16,7 @@ Model (quarter x1, x2 in [0, 20], x3 in [-1/2, 1/2]):
 * --law svk (default) | plate: `plate` is the plate's material of SPEC section 2 written in 3D:
   in-plane plane-stress constants with nothing of E33 in S_ab, S_a3 = k 2 G E_a3 (k = --kshear,
   default 1), S_33 = lambda (E11 + E22) + (lambda + 2 G) E33 (not symmetric).
-* Boundary conditions as stamp's (problem/src/build.rs): symmetry_x1 holds v1- and v1+, i.e. the
+* Boundary conditions as stamp's (problem/src/model/build.rs): symmetry_x1 holds v1- and v1+, i.e. the
   whole fibre, so u1 = 0 on the face x1 = 0; symmetry_x2: u2 = 0 on x2 = 0; simply_supported holds
   v3- and v3+, i.e. u3 = 0 on the whole lateral faces x1 = 20 and x2 = 20 (in-plane motions and
   the fibre's rotation stay free). All by Lagrange multipliers on the face traces (nodal, exact).

@@ -1,0 +1,238 @@
+//! `[[punch]]`: the rigid punches: shape, motion or force, the face they press and the contact
+//! settings.
+
+use super::Problem;
+use super::limits;
+use super::values::{vec_text, Finite, Positive, Vec3};
+use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+use stamp::{quote, Result};
+use toml::Spanned;
+
+/// A punch's prescribed motion: `[d1, d2, d3]` (the displacement at load factor 1, times the load
+/// factor) or rows `[[t, d1, d2, d3], ...]`, a path piecewise linear in the load factor (checked by
+/// [`stamp::contact::PunchMotion::path`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionSpec(pub stamp::contact::PunchMotion);
+impl<'de> Deserialize<'de> for MotionSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Linear(Vec<f64>),
+            Path(Vec<Vec<f64>>),
+        }
+        const FORMS: &str = "expected [d1, d2, d3] (the displacement at load factor 1) or rows [[t, d1, d2, d3], ...] (a path in the load factor t)";
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() <= limits::MAX_MAGNITUDE);
+        match Raw::deserialize(d).map_err(|_| D::Error::custom(FORMS))? {
+            Raw::Linear(v) if v.len() == 3 && finite(&v) => Ok(MotionSpec(stamp::contact::PunchMotion::Linear([v[0], v[1], v[2]]))),
+            Raw::Linear(v) if v.len() == 3 => Err(D::Error::custom(format!("expected three finite numbers of magnitude at most 1e100, got {}", vec_text(&v)))),
+            Raw::Linear(v) => Err(D::Error::custom(format!("{FORMS}, got {} numbers", v.len()))),
+            Raw::Path(rows) => {
+                if rows.len() > limits::MAX_PATH_ROWS {
+                    return Err(D::Error::custom(format!("a path has at most {} rows, got {}", limits::MAX_PATH_ROWS, rows.len())));
+                }
+                let mut path = Vec::with_capacity(rows.len());
+                for (k, r) in rows.iter().enumerate() {
+                    if r.len() != 4 {
+                        return Err(D::Error::custom(format!("path row {k}: expected [t, d1, d2, d3], got {} numbers", r.len())));
+                    }
+                    if !finite(r) {
+                        return Err(D::Error::custom(format!("path row {k}: expected finite numbers of magnitude at most 1e100, got {}", vec_text(r))));
+                    }
+                    path.push((r[0], [r[1], r[2], r[3]]));
+                }
+                stamp::contact::PunchMotion::path(&path).map(MotionSpec).map_err(|e| D::Error::custom(format!("path {e}")))
+            }
+        }
+    }
+}
+
+/// A non-zero 3-vector (a direction).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Direction(pub [f64; 3]);
+impl<'de> Deserialize<'de> for Direction {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let v = Vec3::deserialize(d)?.0;
+        // the squares must stay normal numbers, or normalising loses accuracy (or divides by 0)
+        let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if largest == 0.0 {
+            Err(D::Error::custom("expected a non-zero direction, got [0, 0, 0]"))
+        } else if largest < 1e-150 {
+            Err(D::Error::custom(format!("the direction [{}] is too small to normalise accurately (its largest component must be at least 1e-150)", v.map(|x| format!("{x:e}")).join(", "))))
+        } else {
+            Ok(Direction(v))
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Shape {
+    Cylinder,
+    Sphere,
+    Plane,
+    /// Psi written as an expression in x1, x2, x3 (`psi`).
+    Expression,
+    /// A triangulated surface read from an STL file (`file`).
+    Stl,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum PunchFace {
+    #[default]
+    Top,
+    Bottom,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactKinematicsSpec {
+    Exact,
+    Shallow,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PunchSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub shape: Shape,
+    /// cylinder: a point of the axis; plane: a point of the plane.
+    #[serde(default)]
+    pub point: Option<Vec3>,
+    /// cylinder: the axis direction.
+    #[serde(default)]
+    pub axis: Option<Direction>,
+    /// sphere: the centre.
+    #[serde(default)]
+    pub center: Option<Vec3>,
+    /// cylinder, sphere.
+    #[serde(default)]
+    pub radius: Option<Positive>,
+    /// plane: the normal pointing out of the punch, towards the plate.
+    #[serde(default)]
+    pub normal: Option<Direction>,
+    /// stl: the STL file (ASCII or binary), relative to the problem file; its facet normals point
+    /// to the plate's side.
+    #[serde(default)]
+    pub file: Option<Spanned<String>>,
+    /// expression: Psi in x1, x2, x3 (negative inside the punch, zero on its surface).
+    #[serde(default)]
+    pub psi: Option<Spanned<String>>,
+    /// Punch displacement at load factor 1, or a path of rows [t, d1, d2, d3] ...
+    #[serde(default)]
+    pub motion: Option<MotionSpec>,
+    /// ... or the force pressing the punch at load factor 1 (its displacement along `direction` is
+    /// then an unknown).
+    #[serde(default)]
+    pub force: Option<Finite>,
+    /// Direction of the force (default: towards the plate, -x3 for a punch on the top face, +x3 on
+    /// the bottom face).
+    #[serde(default)]
+    pub direction: Option<Direction>,
+    #[serde(default)]
+    pub face: PunchFace,
+    /// Nodes that may touch (default: every node).
+    #[serde(default)]
+    pub group: Option<Spanned<String>>,
+    /// Regularisation parameter (default: automatic, see model/build.rs).
+    #[serde(default)]
+    pub eps_reg: Option<Positive>,
+    /// Augmented-Lagrangian penetration tolerance (a length).
+    #[serde(default)]
+    pub penetration_tolerance: Option<Spanned<Positive>>,
+    /// Default: exact for a nonlinear plate, shallow (along x3) for a linear one.
+    #[serde(default)]
+    pub kinematics: Option<ContactKinematicsSpec>,
+    /// How the constraint is discretised: "nodal" (the paper's collocation at the nodes) or
+    /// "integrated" (each node's weighted gap over its cells); default: see model/build.rs.
+    #[serde(default)]
+    pub contact: Option<ContactSpec>,
+}
+
+/// `[[punch]] contact`: the discretisation of the contact constraint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactSpec {
+    Nodal,
+    Integrated,
+}
+
+impl Problem {
+    /// The checks of `[[punch]]`: the keys each shape takes, motion or force, the names.
+    pub(super) fn check_punches(&self) -> Result<()> {
+        let s = &self.spec;
+        let mut names = std::collections::BTreeSet::new();
+        for (i, p) in s.punch.iter().enumerate() {
+            let ps = p.get_ref();
+            let key = format!("punch[{i}]");
+            let need = |ok: bool, what: &str| -> Result<()> {
+                if ok {
+                    Ok(())
+                } else {
+                    Err(self.error_at(p.span(), &key, what))
+                }
+            };
+            match ps.shape {
+                Shape::Cylinder => need(
+                    ps.point.is_some() && ps.axis.is_some() && ps.radius.is_some() && ps.center.is_none() && ps.normal.is_none(),
+                    "a cylinder needs `point`, `axis` and `radius` (and no `center` or `normal`)",
+                )?,
+                Shape::Sphere => need(
+                    ps.center.is_some() && ps.radius.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.normal.is_none(),
+                    "a sphere needs `center` and `radius` (and no `point`, `axis` or `normal`)",
+                )?,
+                Shape::Plane => need(
+                    ps.point.is_some() && ps.normal.is_some() && ps.radius.is_none() && ps.axis.is_none() && ps.center.is_none(),
+                    "a plane needs `point` and `normal` (and no `radius`, `axis` or `center`)",
+                )?,
+                Shape::Expression => {
+                    need(
+                        ps.psi.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
+                        "an expression punch needs `psi` (and no `point`, `axis`, `center`, `radius` or `normal`)",
+                    )?;
+                    let psi = ps.psi.as_ref().unwrap();
+                    if let Err(e) = stamp_contact::expression_parser::parse(psi.get_ref()) {
+                        return Err(self.psi_error(psi, e.column, &format!("{key}.psi"), &e.message));
+                    }
+                }
+                Shape::Stl => need(
+                    ps.file.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
+                    "an stl die needs `file` (and no `point`, `axis`, `center`, `radius` or `normal`: the die is where the file puts it)",
+                )?,
+            }
+            if ps.shape != Shape::Expression && ps.psi.is_some() {
+                return Err(self.error_at(ps.psi.as_ref().unwrap().span(), &format!("{key}.psi"), "`psi` belongs to shape = \"expression\""));
+            }
+            if ps.file.is_some() && ps.shape != Shape::Stl {
+                return Err(self.error_at(ps.file.as_ref().unwrap().span(), &format!("{key}.file"), "`file` is the STL file of shape = \"stl\""));
+            }
+            if ps.force.is_some() && ps.motion.is_some() {
+                return Err(self.error_at(p.span(), &format!("{key}.force"), "give `motion` (displacement driven) or `force` (force driven), not both"));
+            }
+            if ps.direction.is_some() && ps.force.is_none() {
+                return Err(self.error_at(p.span(), &format!("{key}.direction"), "`direction` is the direction of `force`; it needs `force`"));
+            }
+            let name = self.punch_name(i);
+            if name.is_empty() || name.chars().count() > limits::MAX_NAME_CHARS || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+                return Err(self.error_at(
+                    p.span(),
+                    &format!("{key}.name"),
+                    format!("'{}' must be 1 to {} letters, digits, '_' or '-' (it names files)", quote(&name), limits::MAX_NAME_CHARS),
+                ));
+            }
+            if !names.insert(name.clone()) {
+                return Err(self.error_at(p.span(), &format!("{key}.name"), format!("two punches are named '{}'", quote(&name))));
+            }
+        }
+        Ok(())
+    }
+
+    /// The name of punch `i` (its `name`, or "`punch<i>`").
+    pub fn punch_name(&self, i: usize) -> String {
+        self.spec.punch[i].get_ref().name.clone().unwrap_or_else(|| if self.spec.punch.len() == 1 { "punch".into() } else { format!("punch{i}") })
+    }
+
+}
