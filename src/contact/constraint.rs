@@ -158,7 +158,7 @@ pub struct ContactPair {
     /// such evaluation does not release them (see [`ContactPair::evaluate`]).
     pub(super) entered: Vec<bool>,
     /// The points that entered with the Gauss-Newton tangent at that evaluation (see
-    /// [`DEEP_ENTRY_RATIO`]): held at the next one also in a step started from an outside
+    /// [`DEEP_ENTRY_RATIO`](super::DEEP_ENTRY_RATIO)): held at the next one also in a step started from an outside
     /// prediction, whose other entries are not held.
     pub(super) entered_deep: Vec<bool>,
     /// Hold a point that entered for one iteration (default true; false: the plain semi-smooth
@@ -172,11 +172,11 @@ pub struct ContactPair {
     /// at once.
     pub release_fraction: f64,
     /// Hold an active point whose trial multiplier turned tensile while that tension fell at
-    /// least [`CONVERGING_TENSION`]-fold since the last evaluation with a tangent (see
+    /// least [`CONVERGING_TENSION`](super::CONVERGING_TENSION)-fold since the last evaluation with a tangent (see
     /// [`ContactPair::evaluate`]); default true.
     pub hold_converging: bool,
     /// The Gauss-Newton tangent for a point that enters the active set deep inside the punch or
-    /// at the body's first contact (see [`DEEP_ENTRY_RATIO`]); default true. False: every active
+    /// at the body's first contact (see [`DEEP_ENTRY_RATIO`](super::DEEP_ENTRY_RATIO)); default true. False: every active
     /// point's tangent is the exact derivative.
     pub gauss_newton_entry: bool,
     /// The body touched the punch in a converged state before this load step: its largest

@@ -1,6 +1,6 @@
 //! The damped growth of the active set: which penetrating points enter in an evaluation with
 //! a tangent, and that the held-back ones still count as changes until they are in.
-use super::{ContactKinematics, ContactPair, ContactPoint};
+use super::{ContactKinematics, ContactPair, ContactPoint, LONE_MAX_FLIPS, RELEASE_FRACTION};
 use crate::surface::ContactSurface;
 use nalgebra::Vector3;
 use std::sync::Arc;

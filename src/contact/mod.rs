@@ -1,5 +1,5 @@
 //! Frictionless contact of a set of points with a rigid punch, by the perturbed Lagrangian method
-//! (paper eqs. 3.8, 3.15-3.16, 4.6, 4.9-4.10, 4.13-4.15), written against [`ContactSurface`] only.
+//! (paper eqs. 3.8, 3.15-3.16, 4.6, 4.9-4.10, 4.13-4.15), written against [`ContactSurface`](crate::surface::ContactSurface) only.
 //!
 //! Every contact point carries a multiplier lambda (a force per unit reference area: the nodal
 //! weights are tributary areas). On the active set the regularised constraint

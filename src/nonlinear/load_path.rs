@@ -7,18 +7,18 @@ use crate::error::{Result, StampError};
 use crate::linalg::linear_solver::LinearSolver;
 use std::time::Instant;
 
-/// The steps over which [`NewtonSettings::max_steps`] measures the pace of a path.
+/// The steps over which [`NewtonSettings::max_steps`](super::NewtonSettings::max_steps) measures the pace of a path.
 pub const PACE_WINDOW: usize = 50;
 /// Attempts of a load step started from [`NewtonRaphson::predictor`]; its later retries (cut
 /// back) start from the secant extrapolation, in case the prediction is what fails (a coarse
 /// mesh far from the answer).
 pub const PREDICTED_ATTEMPTS: usize = 2;
 
-/// The smallest scale of the secant extrapolation ([`NewtonSettings::fit_secant`]).
+/// The smallest scale of the secant extrapolation ([`NewtonSettings::fit_secant`](super::NewtonSettings::fit_secant)).
 pub const SECANT_FIT_MIN: f64 = 0.2;
 
 /// A fit of the last step's secant at least this good keeps the next secant whole
-/// ([`NewtonSettings::fit_secant`]): scaling a good secant by its fit (0.96 to 0.99 on the torus
+/// ([`NewtonSettings::fit_secant`](super::NewtonSettings::fit_secant)): scaling a good secant by its fit (0.96 to 0.99 on the torus
 /// die) moved the torus's first-contact path and cost it 2 to 11 iterations.
 pub const SECANT_FIT_TRUSTED: f64 = 0.9;
 
@@ -39,7 +39,7 @@ fn secant_scale(s: &[f64], end: &[f64], start: &[f64]) -> f64 {
 }
 impl<L: LinearSolver> NewtonRaphson<L> {
     /// Why the path must stop after `steps` converged steps with `remaining` load path left to go
-    /// ([`NewtonSettings::max_steps`]); `recent`: the load factors of the last steps.
+    /// ([`NewtonSettings::max_steps`](super::NewtonSettings::max_steps)); `recent`: the load factors of the last steps.
     fn over_budget(&self, steps: usize, recent: &std::collections::VecDeque<f64>, remaining: f64) -> Option<String> {
         let max = self.settings.max_steps;
         if remaining <= 0.0 || max == usize::MAX {

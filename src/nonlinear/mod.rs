@@ -11,9 +11,9 @@
 //! iteration. A step whose active set swings at every iteration without progress may be given up
 //! early ([`NewtonSettings::cycling_after`], off by default).
 //!
-//! The files: [`settings`] the knobs of Newton and of the load stepping; [`newton`] the Newton
-//! iteration at one load factor and what it calls converged; [`load_path`] the load steps towards
-//! the targets, their increments and cut-backs, the secant predictor; [`contact_resolve`] the
+//! The files: `settings.rs` the knobs of Newton and of the load stepping; `newton.rs` the Newton
+//! iteration at one load factor and what it calls converged; `load_path.rs` the load steps towards
+//! the targets, their increments and cut-backs, the secant predictor; `contact_resolve.rs` the
 //! re-solve of the linearised contact problem after a Newton step's solve.
 
 mod contact_resolve;
@@ -58,7 +58,7 @@ pub trait NonlinearProblem {
     /// The tangent of the last evaluation with `with_tangent`.
     fn matrix(&self) -> SparseColMatRef<'_, usize, f64>;
     /// A symmetric matrix of the same pattern close to the tangent, if the problem has one, for
-    /// [`LinearSolver::factorize_preconditioned`] (see [`crate::element::Element::has_preconditioner`]).
+    /// [`LinearSolver::factorize_preconditioned`](crate::linalg::linear_solver::LinearSolver::factorize_preconditioned) (see [`crate::element::Element::has_preconditioner`]).
     fn preconditioner(&self) -> Option<SparseColMatRef<'_, usize, f64>> {
         None
     }

@@ -38,7 +38,7 @@ pub struct NewtonRaphson<L: LinearSolver> {
     /// the start (then used instead of the secant extrapolation, see
     /// [`NonlinearProblem::start_step`]), false to keep the extrapolation. A
     /// [`crate::mesh::coarse_path::CoarsePath`], say. Not asked for the retries of a step after
-    /// [`PREDICTED_ATTEMPTS`] failed attempts in a row.
+    /// [`PREDICTED_ATTEMPTS`](super::PREDICTED_ATTEMPTS) failed attempts in a row.
     pub predictor: Option<Box<dyn FnMut(usize, f64, f64, &mut [f64]) -> bool>>,
     /// Newton iterations done so far, failed attempts included.
     pub(super) iterations_done: usize,
@@ -50,7 +50,7 @@ impl<L: LinearSolver> NewtonRaphson<L> {
     }
 
     /// Newton iterations done so far by this solver, those of attempts that failed included (a
-    /// path that failed returns no [`SolveSummary`]: the caller subtracts what its steps
+    /// path that failed returns no [`SolveSummary`](super::SolveSummary): the caller subtracts what its steps
     /// reported).
     pub fn iterations_done(&self) -> usize {
         self.iterations_done

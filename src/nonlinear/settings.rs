@@ -26,7 +26,7 @@ pub struct NewtonSettings {
     pub energy_tol: f64,
     /// Most Newton iterations of one solve; a multiplier update inside Newton
     /// ([`multiplier_tol`](Self::multiplier_tol)) starts the count afresh, as a re-solve after
-    /// [`NonlinearProblem::end_step`] does.
+    /// [`NonlinearProblem::end_step`](super::NonlinearProblem::end_step) does.
     pub max_iterations: usize,
     /// Most halvings of the Newton correction in the line search (0: plain Newton).
     pub line_search_steps: usize,
@@ -51,8 +51,8 @@ pub struct NewtonSettings {
     pub extrapolate: bool,
     /// Scale the secant extrapolation by how well the last step's predicted that step's answer:
     /// theta = (du . s) / (s . s), du the converged increment and s the secant it started from,
-    /// clamped to [[`SECANT_FIT_MIN`], 1], and 1 where that fit is at least
-    /// [`SECANT_FIT_TRUSTED`]. A force-driven punch's secant overshoots (its first touch
+    /// clamped to [[`SECANT_FIT_MIN`](super::SECANT_FIT_MIN), 1], and 1 where that fit is at least
+    /// [`SECANT_FIT_TRUSTED`](super::SECANT_FIT_TRUSTED). A force-driven punch's secant overshoots (its first touch
     /// stiffens the plate: fits of 0.2 to 0.6) and sends the plate deep into the punch; a moving
     /// punch's does not (fits above 0.9). Measured on the shipped problems (docs/performance.md):
     /// sphere-ss 38 -> 33, squeeze 38 -> 32 Newton iterations, paper-r100 99 in 11 steps -> 75 in
@@ -80,7 +80,7 @@ pub struct NewtonSettings {
     /// n = 200 with 1e-3: 39 against 24).
     pub forcing: f64,
     /// From this iteration on, a step whose active set changed at each of the last
-    /// [`CYCLING_WINDOW`] iterations while |R| made no progress (the least |R| of the window's
+    /// [`CYCLING_WINDOW`](super::CYCLING_WINDOW) iterations while |R| made no progress (the least |R| of the window's
     /// second half above half that of its first half) is given up and cut back (0: never, the
     /// default). For an active set that swings wholesale at every iteration (first contact of a
     /// fine mesh under a large increment: `stamp bench` at 961 600 unknowns, a thousand points
@@ -93,9 +93,9 @@ pub struct NewtonSettings {
     pub chord_tol: f64,
     /// Once |R| <= multiplier_tol * force scale with an unchanged active set, the problem's
     /// augmented-Lagrangian multipliers are updated inside Newton
-    /// ([`NonlinearProblem::update_multipliers`]) and the iterations go on from the same iterate,
+    /// ([`NonlinearProblem::update_multipliers`](super::NonlinearProblem::update_multipliers)) and the iterations go on from the same iterate,
     /// instead of after Newton converged, with a re-solve of the step
-    /// ([`NonlinearProblem::end_step`], still asked at the end); 0: never. The update moves the
+    /// ([`NonlinearProblem::end_step`](super::NonlinearProblem::end_step), still asked at the end); 0: never. The update moves the
     /// solution by the penetration the penalty left, a small perturbation the next one or two
     /// Newton iterations absorb, while a re-solve costs its own convergence down to round-off:
     /// measured on `stamp bench --problem sphere-displacement` (2026-11-24), 49 / 57 / 54 Newton
@@ -103,7 +103,7 @@ pub struct NewtonSettings {
     /// every step the same to 2e-8 relative (docs/performance.md).
     pub multiplier_tol: f64,
     /// Most converged load steps of a path (`usize::MAX`: no limit). The path also stops as soon
-    /// as the pace of the last [`PACE_WINDOW`] steps (their mean increment) would need more steps
+    /// as the pace of the last [`PACE_WINDOW`](super::PACE_WINDOW) steps (their mean increment) would need more steps
     /// than are left to finish it: a path that crawls (ever smaller increments that converge)
     /// ends with the reason instead of running for hours.
     pub max_steps: usize,
@@ -181,10 +181,9 @@ impl NewtonSettings {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::linalg::linear_solver::SparseLu;
     use crate::nonlinear::test_line::{settings, Line};
-    use crate::nonlinear::{NewtonSettings, NonlinearSolver};
+    use crate::nonlinear::{NewtonRaphson, NewtonSettings, NonlinearSolver};
 
     #[test]
     fn settings_without_iterations_or_with_crossed_increments_are_refused() {

@@ -78,10 +78,10 @@
 //! more GMRES iterations (17-75 %), 8 % of the time at 240 800 unknowns, nothing at 60 400 and a little
 //! loss below; hence off by default.
 //!
-//! The files: [`analysis`] the symbolic phase of a new pattern; [`factorisation`] the numeric LDL^T
-//! and the choice between the direct solve and GMRES; [`solve`] the solves with the factor;
-//! [`fallback`] when and how the sparse LU takes over; [`parallelism`] the factorisation's threads,
-//! chosen by measurement; [`matrix`] the passes over A's values (by rows, its symmetric part, its
+//! The files: `analysis.rs` the symbolic phase of a new pattern; `factorisation.rs` the numeric LDL^T
+//! and the choice between the direct solve and GMRES; `solve.rs` the solves with the factor;
+//! `fallback.rs` when and how the sparse LU takes over; `parallelism.rs` the factorisation's threads,
+//! chosen by measurement; `matrix.rs` the passes over A's values (by rows, its symmetric part, its
 //! backward error).
 
 mod analysis;
@@ -324,7 +324,6 @@ impl LinearSolver for LdltGmres {
         self.use_preconditioner
     }
 
-    /// See [`factorisation`].
     fn factorize_preconditioned(&mut self, a: SparseColMatRef<'_, usize, f64>, p: Option<SparseColMatRef<'_, usize, f64>>) -> Result<()> {
         self.factorize_matrix(a, p)
     }
@@ -333,7 +332,6 @@ impl LinearSolver for LdltGmres {
         self.solve_in_place_to(b, 0.0)
     }
 
-    /// See [`solve`].
     fn solve_in_place_to(&mut self, b: &mut [f64], rtol: f64) -> Result<()> {
         self.solve_to(b, rtol)
     }

@@ -4,6 +4,7 @@ use super::factorisation::pivots;
 use super::matrix::multiply;
 use super::parallelism::FactorParallelism;
 use super::*;
+use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 use faer::sparse::{SparseColMat, Triplet};
 
 pub(super) fn matrix(n: usize, entries: &[(usize, usize, f64)]) -> SparseColMat<usize, f64> {
