@@ -209,7 +209,7 @@ impl ContactPair {
             max_flips: 10,
             lone_max_flips: LONE_MAX_FLIPS,
             lambda_scale: 0.0,
-            surface_at_points: vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; n],
+            surface_at_points: SurfaceAtPoint::none(n),
             entry_fraction: ENTRY_FRACTION,
             first_touch_fraction: Some(FIRST_TOUCH_FRACTION),
             step_start_entry_fraction: Some(STEP_START_ENTRY_FRACTION),

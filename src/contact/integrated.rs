@@ -51,7 +51,7 @@ impl ContactPair {
         for (p, &a) in self.points.iter_mut().zip(&face.area) {
             p.weight = a;
         }
-        self.surface_at_points = vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; face.quadrature.len()];
+        self.surface_at_points = SurfaceAtPoint::none(face.quadrature.len());
         self.face = Some(face);
         Ok(self)
     }

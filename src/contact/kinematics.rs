@@ -14,6 +14,13 @@ pub(super) struct SurfaceAtPoint {
     pub(super) grad: Vector3<f64>,
 }
 
+impl SurfaceAtPoint {
+    /// `n` points where the surface was not queried yet (at NaN, never equal to a position).
+    pub(super) fn none(n: usize) -> Vec<SurfaceAtPoint> {
+        vec![SurfaceAtPoint { x: Vector3::repeat(f64::NAN), psi: 0.0, grad: Vector3::zeros() }; n]
+    }
+}
+
 /// Psi, its gradient with respect to the displacement of the point (or quadrature point), its
 /// derivative with respect to a force-driven punch's unknown s, and where the Hessian is taken
 /// (None: no curvature term, the shallow constraint).

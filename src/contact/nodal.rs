@@ -36,9 +36,7 @@ impl ContactPair {
             point_tangent(&*self.surface, p, self.drive.as_ref(), dn, grad, grad_s, hess_at, w * self.eps_reg, w * curvature, add);
         }
     }
-}
 
-impl ContactPair {
     /// Each point's constraint linearised at the last evaluation, for the re-solve of the
     /// linearised contact problem ([`crate::linearised_contact`]), its coefficients by dof (the
     /// point's three displacements, and the force-driven punch's travel) and its id (0, point):
