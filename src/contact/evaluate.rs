@@ -70,14 +70,13 @@ impl ContactPair {
             self.tangent_points.clear();
             self.tangent_points.resize(self.points.len(), false);
         }
-        for k in 0..self.points.len() {
+        for (k, &(psi, grad, grad_s, hess)) in kin.iter().enumerate() {
             if !evaluated(k) {
                 continue;
             }
             // a halo point (integrated) goes through the same rules as on its owner's process,
             // which counts it
             let changes_before = changes;
-            let (psi, grad, grad_s, hess) = kin[k];
             let trial = self.trial(k, psi);
             let (was_active, active) = self.decide_point(k, trial, first, with_tangent, own(k), &rules, &mut changes, &mut tally);
             if !own(k) {

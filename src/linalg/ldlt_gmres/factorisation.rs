@@ -118,9 +118,6 @@ impl LdltGmres {
         factorize_numeric(sym, buffer, &mut self.factor, &self.col_ptr, &self.row_idx, values.unwrap_or(&self.symmetric_values), par)
     }
 
-    /// x = S^-1 x with the LDL^T factor: by the tree-parallel solve `supernodal` when given (on
-    /// one thread if `par` is sequential; about 30 % faster than faer's there too), by faer's
-
     /// The LDL^T of the current matrix's symmetric part (or the LU where that fails).
     /// After the pass over A ([`split_values`], row sums in `r`): its infinity norm, and whether
     /// it is symmetric (largest asymmetry `worst`, largest entry `size`).
