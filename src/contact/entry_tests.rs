@@ -1,7 +1,9 @@
 //! The damped growth of the active set: which penetrating points enter in an evaluation with
 //! a tangent, and that the held-back ones still count as changes until they are in.
-use super::*;
+use super::{ContactKinematics, ContactPair, ContactPoint, LONE_MAX_FLIPS, RELEASE_FRACTION};
 use crate::surface::ContactSurface;
+use nalgebra::Vector3;
+use std::sync::Arc;
 
 /// The punch's underside is the plane x3 = 0 (Psi = -x3: a point above it, x3 > 0, penetrates).
 struct Plane;
