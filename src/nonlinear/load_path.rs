@@ -52,6 +52,13 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         if window < PACE_WINDOW {
             return None;
         }
+        // increments still growing (a path started with a tiny initial_increment, taken up by
+        // 1.5 a step): not a crawl, the pace of the past says nothing of the steps to come
+        let first = (recent[1] - recent[0]).abs();
+        let last = (recent[window] - recent[window - 1]).abs();
+        if last >= ACCELERATING * first {
+            return None;
+        }
         let pace = (recent[window] - recent[0]).abs() / window as f64;
         let needed = remaining / pace;
         (needed > (max - steps) as f64).then(|| {
@@ -62,6 +69,10 @@ impl<L: LinearSolver> NewtonRaphson<L> {
         })
     }
 }
+
+/// A path whose last increment is this many times the first of the pace window is accelerating
+/// (the increment grows by `growth` after easy steps), not crawling.
+const ACCELERATING: f64 = 8.0;
 
 /// The length of the path through `targets` in turn from the first: sum |t_{k+1} - t_k|.
 fn path_length(targets: &[f64]) -> f64 {
@@ -342,6 +353,12 @@ mod tests {
         // a path that fits is not stopped
         let (mut p, mut u) = (Line::new(), [0.0]);
         NewtonRaphson::new(SparseLu::new(), NewtonSettings { max_steps: 30, ..s }).solve_path(&mut p, &mut u, 0.0, &[0.03], &mut |_, _, _| {}).unwrap();
+        // a path started at an increment of 1e-12 grows by 1.5 a step: 70 steps, more than the
+        // pace window, and no crawl
+        let (mut p, mut u, mut steps) = (Line::new(), [0.0], 0);
+        let s = NewtonSettings { initial_increment: 1e-12, min_increment: 1e-12, max_increment: 0.25, max_steps: 1000, ..settings() };
+        NewtonRaphson::new(SparseLu::new(), s).solve_path(&mut p, &mut u, 0.0, &[1.0], &mut |_, _, _| steps += 1).unwrap();
+        assert!(steps > 50 && (u[0] - 1.0).abs() < 1e-9, "{steps} steps, u = {u:?}");
     }
 
     #[test]

@@ -42,8 +42,7 @@ use stamp_elements::Face;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Default penetration tolerance at the start, as a fraction of the plate thickness.
-pub const DEFAULT_PENETRATION: f64 = 1e-3;
+pub use crate::schema::punches::DEFAULT_PENETRATION;
 /// A punch touches the plate at the start where the gap is below this fraction of the model size.
 pub const TOUCH: f64 = 1e-6;
 
@@ -71,17 +70,114 @@ pub struct CheckReport {
 /// Run every check on a built problem: Err with the first error, else the summary and warnings.
 pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
     check_groups(p, &setup.mesh)?;
+    check_punch_forces(p, setup)?;
     let size = model_size(setup);
     let mut starts = Vec::new();
     for i in 0..setup.punches.len() {
         crate::checks::psi_checks::check_expression(p, setup, i, size)?;
         starts.push(punch_start(p, setup, i, size)?);
+        check_supported_nodes_under(p, setup, i)?;
     }
     let rigid = check_rigid_modes(p, setup, &starts, size)?;
     let mut warnings = punch_warnings(p, setup, &starts);
     warnings.extend(crate::checks::cell_shape::aspect_warning(p, &setup.mesh));
     let summary = summary(p, setup, &starts, &rigid);
     Ok(CheckReport { summary, warnings, punches: starts })
+}
+
+/// The smallest punch force the solve resolves, as a fraction of the plate's stiffness force
+/// E h L: the internal forces carry a round-off of about 4e-16 E h L (measured: the shipped
+/// sphere-ss's residual floor 1.5e-9 for E h L = 4.2e6), which must stay below 1e-6 of the force.
+/// A force of 1e-15 on that plate "converged" at once with the punch unmoved and a reaction of 0;
+/// 1e-6 failed after 12 cut-backs.
+pub const MIN_FORCE_OF_STIFFNESS: f64 = 1e-9;
+
+/// A force-driven punch whose force the solve cannot tell from round-off: refused with the
+/// numbers (its reaction would be round-off, or Newton would never reach its tolerance).
+fn check_punch_forces(p: &Problem, setup: &Setup) -> Result<()> {
+    for (i, pu) in p.spec.punch.iter().enumerate() {
+        let Some(f) = pu.get_ref().force else { continue };
+        let least = MIN_FORCE_OF_STIFFNESS * setup.stiffness;
+        if f.0.abs() < least {
+            return Err(p.error_at(
+                pu.span(),
+                &format!("punch[{i}].force"),
+                format!(
+                    "{:e} is below {least:.1e}, 1e-9 of the plate's stiffness as a force (E h L = {:.3e}: modulus x thickness x larger side): the plate's own round-off (about 1e-16 E h L) would swamp it. Values are numbers in the file's units ([units] only labels them): check the force's and the modulus's units",
+                    f.0, setup.stiffness
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// How deep punch `i` may reach, in its undeformed position, below a node whose surfaces the
+/// supports hold along the punch's travel: its penetration tolerance where the contact face
+/// itself is held, this fraction of the thickness where only another surface is (the plate can
+/// give that much by thinning under huge forces, not more).
+pub const SUPPORTED_THINNING: f64 = 0.1;
+
+/// A displacement-driven punch whose travel presses it onto nodes that the supports hold in its
+/// direction: a fixed node cannot give way, so the run would report "converged" steps with
+/// enormous forces and penetrations (a roller across a plate whose long edges are simply
+/// supported, pressed 4 mm into a 3 mm plate: 1e7 N, 5e6 MPa, 0.46 mm inside), then fail.
+/// Refused with the first such node, how deep the punch reaches there and at what load factor.
+fn check_supported_nodes_under(p: &Problem, setup: &Setup, i: usize) -> Result<()> {
+    let pair = &setup.model.contacts[i];
+    if pair.drive.is_some() || pair.motion.is_zero() {
+        return Ok(());
+    }
+    let dofs = &setup.model.dofs;
+    let dpn = dofs.dofs_per_node();
+    let h = setup.section.thickness();
+    let tol = penetration_tolerance(p, setup, i);
+    // the load factors where the punch is deepest: the targets and the path's rows
+    let mut samples: Vec<f64> = setup.targets.clone();
+    if let stamp::contact::PunchMotion::Path(rows) = &pair.motion {
+        let end = setup.targets.iter().cloned().fold(0.0, f64::max);
+        samples.extend(rows.iter().map(|r| r.0).filter(|&t| t <= end));
+    }
+    for &t in &samples {
+        let d = pair.motion.displacement(t);
+        let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if norm == 0.0 {
+            continue;
+        }
+        // the axis the punch travels along most
+        let axis = (0..3).max_by(|&a, &b| d[a].abs().total_cmp(&d[b].abs())).unwrap_or(2);
+        for q in &pair.points {
+            let own = dofs.equation(q.dofs[axis]).is_none();
+            let any = own || (0..dpn / 3).any(|s| dofs.equation(q.node * dpn + 3 * s + axis).is_none());
+            if !any {
+                continue;
+            }
+            let x = Vector3::from(q.x_ref) - Vector3::from(d);
+            let (psi, g) = pair.surface.psi_and_gradient(&x);
+            let gn = g.norm();
+            if !(gn > 0.0 && psi.is_finite()) {
+                continue;
+            }
+            let depth = -psi / gn;
+            let allowed = if own { tol } else { SUPPORTED_THINNING * h };
+            if depth > allowed {
+                let axis_word = ["x1", "x2", "x3"][axis];
+                return Err(p.error_at(
+                    p.spec.punch[i].span(),
+                    &format!("punch[{i}]"),
+                    format!(
+                        "'{}' presses onto {}, which the supports hold along {axis_word}: at load factor {} its surface lies {} beyond that node's undeformed {}, and a held node cannot give way (the run would end in enormous forces). Move the punch or the supports, or shorten its motion",
+                        quote(&setup.punches[i].name),
+                        where_node(&setup.mesh, q.node),
+                        num(t),
+                        num(depth),
+                        if own { "contact face" } else { "face (the plate would have to thin by more than a tenth)" }
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn file(p: &Problem) -> String {

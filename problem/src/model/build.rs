@@ -70,6 +70,9 @@ pub struct Setup {
     pub punches: Vec<PunchInfo>,
     pub targets: Vec<f64>,
     pub settings: NewtonSettings,
+    /// The plate's stiffness as a force, E h L ([`stiffness_force`]): the scale of Newton's
+    /// absolute tolerance and of the smallest force the solve can resolve.
+    pub stiffness: f64,
     /// `[solver] predictor = "coarse"`: the same problem on the coarse mesh (solved first, see
     /// crate::model::coarse); None otherwise, and on the meshes of `--refine`.
     pub coarse: Option<Box<CoarseSetup>>,
@@ -256,8 +259,9 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
     })?;
     build_loads(p, &mesh, &section, &layout, &mut model)?;
     let punches = build_punches(p, &mesh, &section, young, kinematics, &layout, &mut model)?;
-    let settings = build_solver(p, &mut model)?;
-    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, coarse: None })
+    let stiffness = stiffness_force(&mesh, &section, young);
+    let settings = build_solver(p, &mut model, stiffness)?;
+    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, stiffness, coarse: None })
 }
 
 /// The plate of `[plate]` (with the `[[material]]` tables of its layers): its elements, the
@@ -553,6 +557,10 @@ fn build_punches(p: &Problem, mesh: &MeshData, section: &Section, young: f64, ki
                 ));
             }
             tolerance = Some(tolerance.map_or(tol, |x: f64| x.min(tol)));
+        } else {
+            // the default: a penetration of a sizeable part of the thickness is never converged
+            let tol = crate::schema::punches::DEFAULT_PENETRATION * h;
+            tolerance = Some(tolerance.map_or(tol, |x: f64| x.min(tol)));
         }
         punches.push(PunchInfo { name, face, z, surface, eps_reg, eps_automatic });
     }
@@ -560,8 +568,33 @@ fn build_punches(p: &Problem, mesh: &MeshData, section: &Section, young: f64, ki
     Ok(punches)
 }
 
-/// `[solver]`: Newton's settings, and its tangent on the model.
-fn build_solver(p: &Problem, model: &mut Model<Plate>) -> Result<NewtonSettings> {
+/// The plate's stiffness as a force: E h L (the modulus, the thickness and the plate's larger
+/// side), the force that stretches it by its own length. Newton's absolute tolerance and the
+/// smallest loads are measured against it, so that a problem in other units (E = 1e-20, or a
+/// force of 1e-15 on steel) is judged as the same problem in MPa and mm.
+pub fn stiffness_force(mesh: &MeshData, section: &Section, young: f64) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for x in &mesh.mesh.coords {
+        for d in 0..2 {
+            lo[d] = lo[d].min(x[d]);
+            hi[d] = hi[d].max(x[d]);
+        }
+    }
+    let span = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    young * section.thickness() * span
+}
+
+/// Newton's absolute tolerance as a fraction of [`stiffness_force`] (without `[solver] abs_tol`):
+/// just above the round-off floor of the plate's internal forces (measured 3.6e-16 E h L on the
+/// shipped sphere-ss: 1.5e-9 for E h L = 4.2e6), so that a step whose forces are round-off (an
+/// `initial_increment` of 1e-12, a plate of E = 1e-20 in the same units) is judged by what can
+/// be computed. The shipped problems take the same Newton iterations as with the former absolute
+/// 1e-14 (sphere-ss, sphere-ss-displacement, cylinder-30deg compared step by step).
+pub const ABS_TOL_OF_STIFFNESS: f64 = 1e-15;
+
+/// `[solver]`: Newton's settings, and its tangent on the model; `stiffness` the force E h L
+/// that the absolute tolerance is a fraction of.
+fn build_solver(p: &Problem, model: &mut Model<Plate>, stiffness: f64) -> Result<NewtonSettings> {
     let s = &p.spec;
     model.mixed_tangent = s.solver.newton.unwrap_or_default() == crate::schema::NewtonTangent::Mip;
     let sv = &s.solver;
@@ -578,9 +611,10 @@ fn build_solver(p: &Problem, model: &mut Model<Plate>) -> Result<NewtonSettings>
     if let Some(x) = sv.rel_tol {
         settings.rel_tol = x.0;
     }
-    if let Some(x) = sv.abs_tol {
-        settings.abs_tol = x.0;
-    }
+    settings.abs_tol = match sv.abs_tol {
+        Some(x) => x.0,
+        None => ABS_TOL_OF_STIFFNESS * stiffness,
+    };
     if let Some(x) = sv.max_iterations {
         settings.max_iterations = x.0;
     }

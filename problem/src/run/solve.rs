@@ -344,7 +344,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         crate::run::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
         crate::run::out_dir::RunFolder::claim(out_dir)
     })?;
-    let Setup { mesh, mut model, section, punches, targets, settings, coarse } = setup;
+    let Setup { mesh, mut model, section, punches, targets, settings, coarse, .. } = setup;
     let targets = opts.targets.clone().unwrap_or(targets);
     // the step budget of the path (a refined run passes through the targets it is given)
     let mut settings = settings;

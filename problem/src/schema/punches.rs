@@ -12,6 +12,12 @@ use toml::Spanned;
 /// A punch's prescribed motion: `[d1, d2, d3]` (the displacement at load factor 1, times the load
 /// factor) or rows `[[t, d1, d2, d3], ...]`, a path piecewise linear in the load factor (checked by
 /// [`stamp::contact::PunchMotion::path`]).
+/// Default penetration tolerance, as a fraction of the plate thickness: a punch may start inside
+/// the plate by this much, and a step whose punch ends deeper (or held off by more) is not
+/// converged: augmented-Lagrangian updates press it out first (a step is never reported
+/// converged with the punch deep inside the plate). `[[punch]] penetration_tolerance` sets it.
+pub const DEFAULT_PENETRATION: f64 = 1e-3;
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct MotionSpec(pub stamp::contact::PunchMotion);
 impl<'de> Deserialize<'de> for MotionSpec {
