@@ -1,6 +1,7 @@
 """Bad input raises stamp.StampError (a ValueError) with the program's message, naming the key."""
 
 import tomllib
+import warnings
 
 import numpy as np
 import pytest
@@ -110,3 +111,62 @@ def test_check_reports_without_solving():
     t["boundary"][0]["group"] = "nowhere"
     with pytest.raises(stamp.StampError, match=r"boundary\[0\]\.group: no group named 'nowhere'"):
         stamp.Problem(t).check()
+
+
+# values that would make a naive recursive walk overflow the stack (SIGSEGV): each runs in a
+# child process, so that a crash fails the test instead of killing pytest
+NESTED = {
+    "deep list": "v = 0\nfor _ in range(10000):\n    v = [v]\nt['plate']['E'] = v",
+    "list in itself": "v = [1.0]\nv.append(v)\nt['punch'][0]['center'] = v",
+    "dict in itself": "d = {'a': 1}\nd['self'] = d\nt['output'] = d",
+    "tolist gives itself": "class A:\n    dtype = 'f8'\n    def tolist(self):\n        return self\nt['plate']['E'] = A()",
+    "tolist gives a list of itself": "class A:\n    dtype = 'f8'\n    def tolist(self):\n        return [self]\nt['plate']['E'] = A()",
+}
+
+
+@pytest.mark.parametrize("case", list(NESTED))
+def test_values_nested_too_deep_or_in_themselves_are_refused_naming_the_key(case):
+    import subprocess
+    import sys
+    import textwrap
+
+    code = textwrap.dedent(
+        f"""
+        import sys, tomllib
+        import stamp
+        sys.setrecursionlimit(100000)
+        with open({str(SPHERE)!r}, "rb") as f:
+            t = tomllib.load(f)
+        """
+    ) + NESTED[case] + textwrap.dedent(
+        """
+        try:
+            stamp.Problem(t)
+        except stamp.StampError as e:
+            print("StampError:", str(e)[:400])
+        else:
+            print("accepted")
+        """
+    )
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, f"exit status {p.returncode}: {p.stderr[-2000:]}"
+    out = p.stdout.strip()
+    expected = {
+        "deep list": ("plate.E[0][0]", "nested more than 64 levels deep"),
+        "list in itself": ("punch[0].center[1]", "the list contains itself"),
+        "dict in itself": ("output.self", "the dict contains itself"),
+        "tolist gives itself": ("plate.E", "A.tolist() gave the A itself"),
+        "tolist gives a list of itself": ("plate.E[0][0]", "nested more than 64 levels deep"),
+    }[case]
+    assert out.startswith("StampError: " + expected[0]) and expected[1] in out, out
+
+
+def test_values_nested_64_levels_deep_pass_the_walk():
+    """The limit is the walk's: 64 levels reach the schema, which names the key."""
+    t = table()
+    v = 1.0
+    for _ in range(63):
+        v = [v]
+    t["plate"]["E"] = v
+    m = raised(t)
+    assert "plate.E: invalid type: sequence" in m and "nested" not in m, m
