@@ -1,6 +1,8 @@
-"""Output folders: a result written into its own folder keeps its files."""
+"""Output folders: a result written into its own folder keeps its files; one run at a time writes
+into a folder, also within one process."""
 
 import json
+import threading
 import tomllib
 
 import pytest
@@ -51,3 +53,41 @@ def test_a_result_whose_files_another_run_replaced_is_not_written(tmp_path):
     assert json.loads((out / "summary.json").read_text())["targets"] == [0.5, 1.0]
     second.write(tmp_path / "copy")
     assert json.loads((tmp_path / "copy" / "summary.json").read_text())["targets"] == [0.5, 1.0]
+
+
+def test_two_threads_solving_into_one_folder_one_is_refused(tmp_path):
+    """The folder lock holds within a process too: the second solve is refused as a second
+    `stamp run` would be, instead of both reporting "converged" over each other's files."""
+    t = table()
+    t["mesh"]["rectangle"]["n"] = [20, 20]
+    t["solver"] = {"steps": 20, "max_increment": 0.05}
+    t["output"] = {"vtu": True, "csv": False, "plot": False}
+    p = stamp.Problem(t, name="plate")
+    out = tmp_path / "shared"
+    start = threading.Barrier(2)
+    outcomes = [None, None]
+
+    def solve(k):
+        start.wait()
+        try:
+            outcomes[k] = p.solve(out=out, quiet=True)
+        except stamp.StampError as e:
+            outcomes[k] = e
+
+    threads = [threading.Thread(target=solve, args=(k,)) for k in range(2)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    done = [o for o in outcomes if isinstance(o, stamp.Result)]
+    refused = [o for o in outcomes if isinstance(o, stamp.StampError)]
+    assert len(done) == 1 and len(refused) == 1, outcomes
+    message = str(refused[0])
+    assert str(out) in message and "in use" in message and "another run of this process" in message, message
+    assert done[0].summary["status"] == "converged"
+    # the .pvd lists the files that are there
+    pvd = (out / "plate.pvd").read_text()
+    listed = [part.split('"')[0] for part in pvd.split('file="')[1:]]
+    assert len(listed) == len(done[0].steps) > 0 and all((out / f).exists() for f in listed), listed
+    # the folder is free again: a later solve into it runs
+    assert p.solve(out=out, quiet=True).summary["status"] == "converged"
