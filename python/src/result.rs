@@ -8,7 +8,8 @@ use pyo3::exceptions::{PyIndexError, PyKeyError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use stamp_problem::kept::{Kept, KeptStep};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
 
 #[pyclass(frozen, name = "_Result", module = "stamp._stamp")]
 pub struct NativeResult {
@@ -17,13 +18,21 @@ pub struct NativeResult {
     summary: String,
     /// The temporary output folder, removed when the result is.
     _temp: Option<tempfile::TempDir>,
+    /// Size and modification time of each of `outcome.files` after the solve: [`Self::write`]
+    /// refuses files another run has since removed or rewritten.
+    stamps: Vec<Option<(u64, Option<SystemTime>)>>,
+}
+
+fn stamp_of(path: &Path) -> Option<(u64, Option<SystemTime>)> {
+    std::fs::metadata(path).ok().map(|m| (m.len(), m.modified().ok()))
 }
 
 impl NativeResult {
     pub fn new(mut outcome: stamp_problem::RunOutcome, temp: Option<tempfile::TempDir>) -> PyResult<NativeResult> {
         let summary = std::fs::read_to_string(&outcome.summary).map_err(|e| to_py(stamp::StampError::io(&outcome.summary, e)))?;
         let kept = outcome.kept.take().unwrap_or_default();
-        Ok(NativeResult { outcome, kept, summary, _temp: temp })
+        let stamps = outcome.files.iter().map(|f| stamp_of(f)).collect();
+        Ok(NativeResult { outcome, kept, summary, _temp: temp, stamps })
     }
 
     fn step(&self, i: usize) -> PyResult<&KeptStep> {
@@ -119,9 +128,17 @@ impl NativeResult {
         Ok(d)
     }
 
-    /// Copy the output files into `dir` (claimed as `stamp run --out dir` would claim it).
+    /// Copy the output files into `dir` (claimed as `stamp run --out dir` would claim it); into
+    /// the folder they lie in, nothing to do: their paths. Refused if another run has removed or
+    /// rewritten them since the solve.
     fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
         let files = &self.outcome.files;
+        for (f, s) in files.iter().zip(&self.stamps) {
+            if s.is_none() || stamp_of(f) != *s {
+                let why = "removed or rewritten since the solve (another run wrote into its folder?): the result's files are lost, its arrays are still here";
+                return Err(to_py(stamp::StampError::io(f, std::io::Error::other(why))));
+            }
+        }
         py.detach(|| stamp_problem::out_dir::copy_run(files, &dir)).map_err(to_py)
     }
 }

@@ -36,6 +36,9 @@ def _index_array(value, key, ndim, columns=None):
     if not (_np.issubdtype(a.dtype, _np.integer) or a.size == 0):
         raise StampError(f"{key}: expected whole numbers (indices, 0-based), got an array of {a.dtype}")
     if a.ndim != ndim or (columns is not None and a.shape[1] not in columns):
+        if ndim == 2 and a.ndim == 2 and columns is not None and a.shape[0] in columns and a.shape[1] > max(columns):
+            want = " or ".join(f"(m, {c})" for c in sorted(columns, reverse=True))
+            raise StampError(f"{key}: shape ({a.shape[0]}, m) with m = {a.shape[1]}: expected {want}; transposed? (give {key}.T)")
         want = "a 1-D array" if ndim == 1 else f"an (m, {' or '.join(map(str, sorted(columns)))}) array"
         raise StampError(f"{key}: expected {want}, got shape {a.shape}")
     if a.size and a.min() < 0:
@@ -50,10 +53,18 @@ def _mesh_arrays(mesh):
     if nodes is None or cells is None:
         raise StampError("mesh: give both `nodes` (an (n, 2) array) and `cells` (an (m, 3) or (m, 4) array)")
     try:
-        xy = _np.asarray(nodes, dtype=_np.float64)
-    except Exception as e:
+        xy = _np.asarray(nodes)
+    except Exception as e:  # ragged lists and the like
         raise StampError(f"mesh.nodes: expected an (n, 2) array of numbers ({e})") from None
+    # real numbers only: numpy would drop a complex number's imaginary part with a mere warning,
+    # read strings as numbers and bools as 0 and 1
+    if xy.size and xy.dtype.kind not in "iuf":
+        what = {"b": "bools", "c": "complex numbers", "U": "strings", "S": "bytes", "O": "Python objects"}.get(xy.dtype.kind, str(xy.dtype))
+        raise StampError(f"mesh.nodes: expected real numbers (x1, x2), got an array of {what} ({xy.dtype})")
+    xy = xy.astype(_np.float64)
     if xy.ndim != 2 or xy.shape[1] not in (2, 3):
+        if xy.ndim == 2 and xy.shape[0] in (2, 3) and xy.shape[1] > 3:
+            raise StampError(f"mesh.nodes: shape ({xy.shape[0]}, n) with n = {xy.shape[1]}: expected (n, 2) (or (n, 3) with z = 0); transposed? (give mesh.nodes.T)")
         raise StampError(f"mesh.nodes: expected an (n, 2) array (or (n, 3) with z = 0), got shape {xy.shape}")
     if xy.shape[1] == 3:
         if _np.any(xy[:, 2] != 0):
@@ -102,9 +113,11 @@ class Problem:
                     "side": {"segments": pairs},     # a curve group: (k, 2) node pairs (line loads)
                     "plate": {"cells": ids}}}        # a surface group (pressures, punch zones)
 
-    Triangles are cut into three quadrilaterals each, as the gmsh reader cuts them; the mesh is
-    checked as a gmsh file is (orientation, overlaps, hanging nodes). Errors about the arrays name
-    the row.
+    Coordinates are real numbers (complex numbers, strings and bools are refused, not converted);
+    a group's name cannot start with ``#`` (the key of a gmsh group by number). Triangles are cut
+    into three quadrilaterals each, as the gmsh reader cuts them; the mesh is checked as a gmsh
+    file is (orientation, overlaps, hanging nodes). Errors about the arrays name the row; an array
+    of shape (3 or 4, m) is named as transposed.
 
     ``name`` names the problem in messages and its output files (``name_0001.vtu``); relative
     paths in the table (a mesh ``file``, an STL punch's ``file``) start in its folder, the working
@@ -121,7 +134,13 @@ class Problem:
         mesh = table.get("mesh")
         if isinstance(mesh, dict) and any(k in mesh for k in ("nodes", "cells", "groups")):
             table["mesh"], nodes, cells, groups = _mesh_arrays(mesh)
-            self._p = _stamp.problem_from_dict(table, str(name), nodes, cells, groups)
+            try:
+                self._p = _stamp.problem_from_dict(table, str(name), nodes, cells, groups)
+            except StampError as e:
+                # (3 or 4, 3 or 4): the shape of a few cells given transposed too
+                if str(e).startswith("mesh:") and cells.shape[0] in (3, 4) and cells.shape[1] in (3, 4):
+                    raise StampError(f"{e} (mesh.cells has shape {cells.shape}, also that of {cells.shape[0]} cells given transposed: if so, give mesh.cells.T)") from None
+                raise
         else:
             self._p = _stamp.problem_from_dict(table, str(name))
 

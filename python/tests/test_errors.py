@@ -1,6 +1,7 @@
 """Bad input raises stamp.StampError (a ValueError) with the program's message, naming the key."""
 
 import tomllib
+import warnings
 
 import numpy as np
 import pytest
@@ -110,3 +111,123 @@ def test_check_reports_without_solving():
     t["boundary"][0]["group"] = "nowhere"
     with pytest.raises(stamp.StampError, match=r"boundary\[0\]\.group: no group named 'nowhere'"):
         stamp.Problem(t).check()
+
+
+# values that would make a naive recursive walk overflow the stack (SIGSEGV): each runs in a
+# child process, so that a crash fails the test instead of killing pytest
+NESTED = {
+    "deep list": "v = 0\nfor _ in range(10000):\n    v = [v]\nt['plate']['E'] = v",
+    "list in itself": "v = [1.0]\nv.append(v)\nt['punch'][0]['center'] = v",
+    "dict in itself": "d = {'a': 1}\nd['self'] = d\nt['output'] = d",
+    "tolist gives itself": "class A:\n    dtype = 'f8'\n    def tolist(self):\n        return self\nt['plate']['E'] = A()",
+    "tolist gives a list of itself": "class A:\n    dtype = 'f8'\n    def tolist(self):\n        return [self]\nt['plate']['E'] = A()",
+}
+
+
+@pytest.mark.parametrize("case", list(NESTED))
+def test_values_nested_too_deep_or_in_themselves_are_refused_naming_the_key(case):
+    import subprocess
+    import sys
+    import textwrap
+
+    code = textwrap.dedent(
+        f"""
+        import sys, tomllib
+        import stamp
+        sys.setrecursionlimit(100000)
+        with open({str(SPHERE)!r}, "rb") as f:
+            t = tomllib.load(f)
+        """
+    ) + NESTED[case] + textwrap.dedent(
+        """
+        try:
+            stamp.Problem(t)
+        except stamp.StampError as e:
+            print("StampError:", str(e)[:400])
+        else:
+            print("accepted")
+        """
+    )
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, f"exit status {p.returncode}: {p.stderr[-2000:]}"
+    out = p.stdout.strip()
+    expected = {
+        "deep list": ("plate.E[0][0]", "nested more than 64 levels deep"),
+        "list in itself": ("punch[0].center[1]", "the list contains itself"),
+        "dict in itself": ("output.self", "the dict contains itself"),
+        "tolist gives itself": ("plate.E", "A.tolist() gave the A itself"),
+        "tolist gives a list of itself": ("plate.E[0][0]", "nested more than 64 levels deep"),
+    }[case]
+    assert out.startswith("StampError: " + expected[0]) and expected[1] in out, out
+
+
+def test_values_nested_64_levels_deep_pass_the_walk():
+    """The limit is the walk's: 64 levels reach the schema, which names the key."""
+    t = table()
+    v = 1.0
+    for _ in range(63):
+        v = [v]
+    t["plate"]["E"] = v
+    m = raised(t)
+    assert "plate.E: invalid type: sequence" in m and "nested" not in m, m
+
+
+@pytest.mark.parametrize(
+    "nodes, message",
+    [
+        (np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=complex), "mesh.nodes: expected real numbers (x1, x2), got an array of complex numbers"),
+        ([["0", "0"], ["1", "0"], ["1", "1"], ["0", "1"]], "mesh.nodes: expected real numbers (x1, x2), got an array of strings"),
+        (np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=bool), "mesh.nodes: expected real numbers (x1, x2), got an array of bools"),
+        ([[0, 0], [1, 0], [1, 1], [0, None]], "mesh.nodes: expected real numbers (x1, x2), got an array of Python objects"),
+        (np.zeros((2, 6)), "mesh.nodes: shape (2, n) with n = 6: expected (n, 2) (or (n, 3) with z = 0); transposed?"),
+    ],
+)
+def test_mesh_nodes_are_real_numbers_in_rows(nodes, message):
+    t = table()
+    t["mesh"] = {"nodes": nodes, "cells": [[0, 1, 2, 3]]}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no ComplexWarning: refused before numpy drops anything
+        m = raised(t)
+    assert message in m, m
+
+
+def test_nodes_with_a_zero_z_column_are_taken():
+    """As documented (help(stamp.Problem), docs/python.md): (n, 3) with z = 0 is the (n, 2) mesh."""
+    from test_dict import rectangle_groups
+
+    xy, cells = square_grid(10)
+    xy *= 2.0
+    t = table()
+    t["mesh"] = {"nodes": xy, "cells": cells, "groups": rectangle_groups(xy, 10)}
+    want = stamp.Problem(t).check()
+    t["mesh"] = {"nodes": np.hstack([xy, np.zeros((len(xy), 1))]), "cells": cells, "groups": rectangle_groups(xy, 10)}
+    assert stamp.Problem(t).check() == want
+
+
+def test_transposed_cells_are_named_as_such():
+    xy, cells = square_grid(3)
+    t = table()
+    t["mesh"] = {"nodes": xy, "cells": cells.T}
+    m = raised(t)
+    assert "mesh.cells: shape (4, m) with m = 9: expected (m, 4) or (m, 3); transposed?" in m, m
+    # four cells transposed have a valid shape: the mesh's error says what it may be
+    xy, cells = square_grid(2)
+    t["mesh"] = {"nodes": xy, "cells": cells.T}
+    m = raised(t)
+    assert "element 1" in m and "mesh.cells has shape (4, 4), also that of 4 cells given transposed" in m, m
+
+
+def square_grid(n):
+    """An n x n grid of unit squares: (nodes, cells)."""
+    xy = np.array([[i, j] for j in range(n + 1) for i in range(n + 1)], dtype=float)
+    idx = lambda i, j: j * (n + 1) + i
+    cells = np.array([[idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)] for j in range(n) for i in range(n)])
+    return xy, cells
+
+
+def test_a_group_named_like_a_gmsh_number_is_refused_not_dropped():
+    xy, cells = square_grid(2)
+    t = table()
+    t["mesh"] = {"nodes": xy, "cells": cells, "groups": {"#1": {"nodes": [0]}}}
+    m = raised(t)
+    assert "mesh.groups.#1: a group's name cannot start with '#'" in m, m

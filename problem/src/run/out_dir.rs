@@ -155,7 +155,31 @@ impl RunFolder {
 /// Copy the files of a finished run (`files`, as [`super::RunOutcome::files`] lists them) into
 /// `dir`, claimed as a run would claim it: the previous run's files there are removed first and
 /// the manifest then lists these. Each file appears whole or not at all. Returns the new paths.
+///
+/// Into the folder the files already lie in (the same canonical path) nothing is copied and
+/// nothing removed: the files' paths are returned as they are (claiming the folder would remove
+/// the very files to copy). A run whose files lie partly in `dir` or below it (`--refine`'s
+/// `refined/`) and partly elsewhere is refused.
 pub fn copy_run(files: &[PathBuf], dir: &Path) -> Result<Vec<PathBuf>> {
+    if let Ok(target) = dir.canonicalize() {
+        let canonical = |f: &Path| f.canonicalize().map_err(|e| StampError::io(f, e));
+        let mut inside = 0;
+        for f in files {
+            let c = canonical(f)?;
+            if c.parent() == Some(target.as_path()) {
+                inside += 1;
+            } else if c.starts_with(&target) {
+                inside = usize::MAX;
+                break;
+            }
+        }
+        if inside == files.len() && !files.is_empty() {
+            return Ok(files.to_vec());
+        }
+        if inside > 0 {
+            return Err(StampError::io(dir, std::io::Error::other("the run's files lie partly in this folder (or below it) and partly elsewhere: writing them into it would remove some of them first; choose another folder")));
+        }
+    }
     let folder = RunFolder::claim(dir)?;
     let mut copied = Vec::with_capacity(files.len());
     for from in files {
@@ -339,6 +363,30 @@ mod tests {
         assert_eq!(f.removed, ["a_0001.vtu", "summary.json"]);
         drop(f);
         assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "later.txt", "notes.txt"]);
+    }
+
+    #[test]
+    fn copying_a_run_into_its_own_folder_keeps_its_files() {
+        let d = dir("copy-self");
+        let files: Vec<PathBuf> = {
+            let _f = RunFolder::claim(&d).unwrap();
+            ["summary.json", "p_0001.vtu"].iter().map(|n| { std::fs::write(d.join(n), *n).unwrap(); d.join(n) }).collect()
+        };
+        // the same folder, named otherwise: nothing removed, nothing copied
+        let same = d.join(".").join("..").join(d.file_name().unwrap());
+        assert_eq!(copy_run(&files, &same).unwrap(), files);
+        assert_eq!(names(&d), [".stamp-lock", ".stamp-run", "p_0001.vtu", "summary.json"]);
+        assert_eq!(std::fs::read_to_string(d.join("p_0001.vtu")).unwrap(), "p_0001.vtu");
+        // another folder: copied, the originals stay
+        let other = d.join("copy");
+        let copied = copy_run(&files, &other).unwrap();
+        assert_eq!(copied, [other.join("summary.json"), other.join("p_0001.vtu")]);
+        assert_eq!(std::fs::read_to_string(other.join("summary.json")).unwrap(), "summary.json");
+        assert!(d.join("summary.json").exists());
+        // files partly in the folder: refused, nothing removed
+        let mixed = vec![files[0].clone(), other.join("p_0001.vtu")];
+        assert!(copy_run(&mixed, &d).unwrap_err().to_string().contains("partly in this folder"));
+        assert!(d.join("summary.json").exists() && d.join("p_0001.vtu").exists());
     }
 
     #[test]

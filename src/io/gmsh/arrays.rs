@@ -61,6 +61,11 @@ pub fn mesh_from_arrays(label: &Path, nodes: &[[f64; 2]], cells: &[Vec<usize>], 
         if group.name.is_empty() {
             return Err(err("mesh.groups: a group has an empty name".into()));
         }
+        // "#<tag>" is the key of a gmsh group by number, which the arrays' groups do not keep (the
+        // numbers would only repeat the names) and which outputs leave out as unnamed
+        if group.name.starts_with('#') {
+            return Err(err(format!("mesh.groups.{}: a group's name cannot start with '#' (\"#<number>\" names a gmsh group by its number; a mesh given as arrays has named groups only)", group.name)));
+        }
         raw.physical_names.push(PhysicalName { dim: dim_of(&group.items), tag, name: group.name.clone() });
         if let GroupItems::Cells(list) = &group.items {
             for (row, &c) in list.iter().enumerate() {
@@ -185,6 +190,14 @@ mod tests {
         assert_eq!(m.mesh.node_groups["right_half"], vec![1, 2, 4, 5]);
         assert!(m.split_summary().is_none());
         assert!(m.point_groups.keys().chain(m.mesh.node_groups.keys()).all(|k| !k.starts_with('#')));
+    }
+
+    #[test]
+    fn a_group_named_like_a_gmsh_number_is_refused() {
+        let cells = vec![vec![0, 1, 4, 3], vec![1, 2, 5, 4]];
+        let groups = vec![ArrayGroup { name: "#1".into(), items: GroupItems::Nodes(vec![0]) }];
+        let e = mesh_from_arrays(Path::new("mesh"), &square(), &cells, &groups).unwrap_err().to_string();
+        assert!(e.contains("mesh.groups.#1: a group's name cannot start with '#'"), "{e}");
     }
 
     #[test]
