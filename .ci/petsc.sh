@@ -133,6 +133,17 @@ elif [ "$(grep -c '^error: ' "$work/nan.err")" = 1 ] && grep -q "psi is NaN at x
 else
   bad "a Psi failure on 4 ranks: $(cat "$work/nan.err") against one process: $(cat "$work/nan-1.err")"
 fi
+# ranks whose problem files differ (E on rank 1): refused before the solve, not a deadlock
+sed 's/^E = 2.1e5/E = 2.0e5/' meshes/sphere-ss-displacement.toml >"$work/other-e.toml"
+if timeout 120 "${mpirun[@]}" -n 1 "$stamp" run meshes/sphere-ss-displacement.toml --out "$work/diff" -q : -n 1 "$stamp" run "$work/other-e.toml" --out "$work/diff" -q 2>"$work/diff.err"; then
+  bad "ranks with different problem files: the job succeeded"
+elif [ $? = 124 ]; then
+  bad "ranks with different problem files: the job hung"
+elif grep -q "the ranks read different problems" "$work/diff.err"; then
+  ok
+else
+  bad "ranks with different problem files: $(cat "$work/diff.err")"
+fi
 # a bad problem file on 4 ranks: one message
 printf '[mesh]\nrectangle = [1, 1]\nno_such_key = 3\n' >"$work/bad.toml"
 if timeout 120 "${mpirun[@]}" -n 4 "$stamp" run "$work/bad.toml" -q 2>"$work/bad.err"; then

@@ -14,7 +14,7 @@ fn tables_1_and_2_and_the_reaction_check() {
     }
     for row in &r.table2 {
         assert!(row.v3_rel_diff.abs() < 0.0015, "Table 2, P = {}: v3 = {} vs {}", row.p, row.v3, row.paper[2]);
-        // b_ext may lie up to two nodes inside the paper's (docs/verification.md); never outside it
+        // b_ext may lie up to two nodes inside the paper's (docs/verification/paper.md); never outside it
         assert!(row.b_ext <= row.paper[1] && row.paper[1] - row.b_ext <= 5.0 + 1e-9, "Table 2, P = {}: b_ext {} vs {}", row.p, row.b_ext, row.paper[1]);
         assert_eq!(row.b_int, 0.0, "Table 2 has no lift-off at the centre");
         assert!((row.reaction - row.load_per_end).abs() <= 1e-8 * row.load_per_end, "P = {}: reaction {} vs {}", row.p, row.reaction, row.load_per_end);

@@ -137,6 +137,15 @@ fn a_number_with_a_unit_is_told_that_units_are_labels() {
         let e = refused(case, &BASE.replace(from, to), Some(to), &[shown, "number followed by a unit", "[units]"]);
         assert!(!e.contains("must be quoted"), "{case}: {e}");
     }
+    // with [units] pressure = "MPa": the value converted (not "write 210": 1000 times too soft);
+    // quoted the same
+    let mpa = format!("{BASE}\n[units]\nlength = \"mm\"\nforce = \"N\"\npressure = \"MPa\"\n");
+    for (case, to) in [("unit_mpa", "E = 210 GPa"), ("unit_quoted", "E = \"210 GPa\"")] {
+        let e = refused(case, &mpa.replace("E = 2.0e4", to), Some(to), &["'210 GPa'", "stamp converts nothing", "with [units] pressure = \"MPa\", write 210000"]);
+        assert!(!e.contains("write 210)") && !e.contains("invalid type"), "{case}: {e}");
+    }
+    // without [units]: converted into MPa as an example, and told to name the unit
+    refused("unit_no_table", &BASE.replace("E = 2.0e4", "E = 210 GPa"), Some("E = 210 GPa"), &["210 GPa is 210000 in MPa", "name that unit in [units] pressure"]);
     // a word that is no number keeps toml's message
     refused("bare_word", &BASE.replace("E = 2.0e4", "E = steel"), Some("E = steel"), &["plate.E"]);
 }

@@ -118,7 +118,7 @@ fn a_line_contact_is_reported_narrower_than_the_cells_and_a_probe_reads_its_load
 /// the coarse predictor: each shipped example run with it converges, a force-driven punch carries
 /// its force, and the punch's force (or travel) is within a few
 /// percent of the nodal discretisation's on these coarse meshes (both converge to the same
-/// answer, docs/verification.md).
+/// answer, docs/verification/contact-pressure.md).
 #[test]
 fn the_integrated_discretisation_runs_every_punch_shape_and_feature() {
     // (example, what it adds, extra solver key, tolerance on the force or travel)

@@ -282,9 +282,14 @@ fn bad_laminate_keys_are_refused_by_name() {
         ("two_e", good.replace("E = [25.0, 1.0, 1.0]", "E = [25.0, 1.0]"), vec!["E", "three numbers", "got 2"]),
         ("unstable", good.replace("nu = [0.25, 0.25, 0.25]", "nu = [0.25, 0.25, 1.5]"), vec!["material[0]", "not positive definite"]),
         ("thin", good.replacen("thickness = 0.25", "thickness = -0.25", 1), vec!["plate.layers[0].thickness", "positive"]),
+        ("ply_1e-101", good.replacen("thickness = 0.25", "thickness = 1e-101", 1), vec!["plate.layers[0].thickness", "from 1e-100 to 1e100"]),
+        ("tiny_e", good.replace("E = [25.0, 1.0, 1.0]", "E = [25.0, 1e-300, 1.0]"), vec!["material[0].E", "positive moduli from 1e-100 to 1e100"]),
+        ("huge_g", good.replace("G = [0.5, 0.5, 0.2]", "G = [0.5, 1e300, 0.2]"), vec!["material[0].G", "positive moduli from 1e-100 to 1e100"]),
         ("unused", pagano_problem(2, 3).replace("layers = [", "E = 1.0\nnu = 0.3\nthickness = 1.0\nxlayers = ["), vec!["unknown field `xlayers`"]),
         ("no_e", good.replace("layers = [", "xx = [").replace("surfaces = 3", ""), vec!["unknown field `xx`"]),
         ("expression", good.replace("sin(pi*x1/10)", "sin(pi*x1/10"), vec!["load[0].pressure", "')'"]),
+        ("overflow", good.replace("sin(pi*x1/10)", "1.7e308*sin(pi*x1/10)"), vec!["load[0].pressure", "beyond 1e100, the largest magnitude"]),
+        ("huge", good.replace("sin(pi*x1/10)", "1e300*sin(pi*x1/10)"), vec!["load[0].pressure", "beyond 1e100, the largest magnitude"]),
         ("x3", good.replace("sin(pi*x1/10)", "sin(pi*x3/10)"), vec!["load[0].pressure", "cannot use x3"]),
     ] {
         let path = write(&dir, &format!("{name}.toml"), &text);

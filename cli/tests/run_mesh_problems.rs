@@ -185,7 +185,7 @@ fn sphere_displacement_driven() {
 
 /// The shipped four-surface example: in equilibrium, penetration within its tolerance, and on its
 /// 20 x 20 mesh within 1 % of the mesh-converged 3D force at the final travel (395.13,
-/// docs/verification.md; measured +0.75 %), where the paper's plate on the same mesh is 6.5 % off.
+/// docs/verification/elasticity-3d.md; measured +0.75 %), where the paper's plate on the same mesh is 6.5 % off.
 #[test]
 fn sphere_with_four_surfaces() {
     let s = check_sphere_quarter("sphere-ss-4surfaces");

@@ -194,7 +194,7 @@ fn solver_keys_reach_the_newton_settings() {
 
 /// The plate's model choices reach the model: on the simply supported plate under a sphere
 /// (10 x 10) the mean transverse normal stress and the shear factor 5/6 each make the plate
-/// softer under the punch (docs/verification.md, "Against 3D elasticity": -2.2 % together on this
+/// softer under the punch (docs/verification/elasticity-3d.md: -2.2 % together on this
 /// mesh), and the paper's default is the result of the shipped file.
 #[test]
 fn plate_model_choices_soften_the_plate_under_the_sphere() {

@@ -84,7 +84,7 @@ fn stamp_paper_plot_says_where_figure4_was_written() {
     assert!(!cited.is_empty(), "{stdout}");
     for doc in cited {
         let text = std::fs::read_to_string(repo().join(doc.trim_end_matches(|c: char| !c.is_alphanumeric()))).unwrap_or_else(|e| panic!("{doc}: {e}"));
-        assert!(text.contains("## The paper's benchmark"), "{doc}");
+        assert!(text.contains("# The paper's benchmark"), "{doc}");
     }
     let line = format!("stamp paper: Figure 4 written to {}, .svg, .csv", out.join("figure4.png").display());
     assert_eq!(stdout.lines().last(), Some(line.as_str()), "{stdout}");

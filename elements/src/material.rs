@@ -78,7 +78,7 @@ pub struct Section {
     pub delta_minus: f64,
     pub delta_plus: f64,
     pub layers: Vec<Layer>,
-    /// Transverse shear factor k in S_a3 = k G 2E_a3 (SPEC section 2: k = 1, no correction, the
+    /// Transverse shear factor k in S_a3 = k G 2E_a3 (the paper's eq. 2.6, docs/design.md "The model": k = 1, no correction, the
     /// default and the paper's; 5/6 is Reissner's value for a parabolic shear stress).
     #[serde(default = "unit_shear_factor")]
     pub shear_factor: f64,
@@ -92,7 +92,7 @@ pub struct Section {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum NormalStress {
-    /// S_ab by the plane-stress constants alone (b_ab33 = 0, SPEC section 2): the paper's.
+    /// S_ab by the plane-stress constants alone (b_ab33 = 0: the paper's eq. 2.6, docs/design.md "The model"): the paper's.
     #[default]
     Dropped,
     /// S_ab = plane-stress law + nu / (1 - nu) S33m delta_ab, S33m = T33 / h the mean transverse

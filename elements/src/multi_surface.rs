@@ -13,7 +13,7 @@
 //! So the transverse shear strain may take its parabolic (or richer) profile without a correction
 //! factor, the thickness may change across the section (local indentation under a punch), and the
 //! full 3D Saint Venant-Kirchhoff law S = lambda tr(E) I + 2 mu E holds at every point: no
-//! plane-stress reduction and no b_ab33 = 0 (SPEC section 2), because E33, now at least linear in
+//! plane-stress reduction and no b_ab33 = 0 (the paper's eq. 2.6), because E33, now at least linear in
 //! x3, can follow the linear in-plane strains of bending, and the Poisson locking that b_ab33 = 0
 //! cures in the paper's plate does not arise. The paper's plate is the case N = 2; as N grows the
 //! model converges to 3D elasticity.
@@ -40,7 +40,7 @@
 //! largest eigenvalue on a 2 x 1 x 2 element) and costs -0.12 % on the cantilever's 40 elements.
 //! It is a stabilisation in the sense of hourglass control: constant strains (the patch test) and
 //! rigid motions are untouched, and the variation it scales vanishes as the mesh is refined.
-//! Measured variants: docs/verification.md.
+//! Measured variants: docs/verification/elasticity-3d.md.
 
 use crate::geometries::Geometries;
 use crate::geometry::{ElementGeometry, GAUSS_POINTS};

@@ -77,8 +77,8 @@ pub fn format_report(r: &PaperReport) -> String {
         let p = super::strip::StripProblem::paper(100.0, stamp_elements::Kinematics::Nonlinear);
         p.half_length / p.elements as f64
     };
-    s.push_str(&format!("Zones: nodes whose |lambda| exceeds 0.5 % of the largest. {}; docs/verification.md\n", b_ext_note(&r.table2, spacing)));
-    s.push_str("(\"The paper's benchmark\") says why we do not tune to it. The geometric active sets are in `stamp paper --json`.\n");
+    s.push_str(&format!("Zones: nodes whose |lambda| exceeds 0.5 % of the largest. {}; docs/verification/paper.md\n", b_ext_note(&r.table2, spacing)));
+    s.push_str("says why we do not tune to it. The geometric active sets are in `stamp paper --json`.\n");
     let iters: usize = r.table1.iter().map(|x| x.linear.newton_iterations + x.nonlinear.newton_iterations).sum::<usize>() + r.table2.iter().map(|x| x.newton_iterations).sum::<usize>();
     s.push_str(&format!("Newton iterations: {iters} in all; wall time {:.3} s\n", r.seconds));
     s

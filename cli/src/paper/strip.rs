@@ -30,14 +30,14 @@ pub struct StripProblem {
     /// the element length, because the paper sums nodal values without weights).
     pub eps_reg: f64,
     pub kinematics: Kinematics,
-    /// Relative threshold on |lambda| that defines the loaded zone (docs/verification.md, "The paper's benchmark").
+    /// Relative threshold on |lambda| that defines the loaded zone (docs/verification/paper.md).
     pub loaded_threshold: f64,
 }
 
 impl StripProblem {
     /// The paper's plate around a cylinder of radius `radius`. eps_reg is the paper's R = 100 value
     /// (10, for unweighted nodal sums) as a density, 10 / 2.5 = 4, for both radii: with lambda a
-    /// density v3 and the zones do not depend on it (docs/verification.md: eps_reg 1 to 1000), and the
+    /// density v3 and the zones do not depend on it (docs/verification/paper.md: eps_reg 1 to 1000), and the
     /// paper's 1e5 for R = 1000 makes the contact stiffness 1e7 times the plate's, which puts the
     /// round-off floor of the residual above 1e-8.
     pub fn paper(radius: f64, kinematics: Kinematics) -> Self {

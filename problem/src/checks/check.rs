@@ -71,6 +71,7 @@ pub struct CheckReport {
 pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
     check_groups(p, &setup.mesh)?;
     check_punch_forces(p, setup)?;
+    check_outputs(p, setup)?;
     let size = model_size(setup);
     let mut starts = Vec::new();
     for i in 0..setup.punches.len() {
@@ -107,6 +108,22 @@ fn check_punch_forces(p: &Problem, setup: &Setup) -> Result<()> {
                     f.0, setup.stiffness
                 ),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// What the run checks of the outputs before its first step, checked here too so that `stamp
+/// check` passes only what `stamp run` accepts: probe lines and thickness probes on the plate (a
+/// point off the mesh, "equilibrium" where the cells around the point cannot be fitted), and
+/// thickness probes only on plates that have stresses through the thickness.
+fn check_outputs(p: &Problem, setup: &Setup) -> Result<()> {
+    let names: Vec<String> = setup.punches.iter().map(|i| i.name.clone()).collect();
+    crate::outputs::probe::Probes::new(p, &setup.mesh, &p.spec.output.probe, &names)?;
+    crate::outputs::thickness_probe::ThicknessProbes::new(p, &setup.mesh)?;
+    if let Some(first) = p.spec.output.thickness_probe.first() {
+        if setup.model.element.stress_stack().is_none() {
+            return Err(p.error_at(first.span(), "output.thickness_probe[0]", "a thickness probe reads the stresses through the thickness: it needs `[plate] surfaces` = 3 to 5, or `layers`"));
         }
     }
     Ok(())
@@ -396,7 +413,7 @@ fn check_rigid_modes(p: &Problem, setup: &Setup, starts: &[PunchStart], size: f6
         let involves = |idx: &[usize]| basis.iter().any(|b| idx.iter().any(|&i| b[i].abs() > 1e-6 * b.norm()));
         let mut advice = Vec::new();
         if involves(&[0, 1, 5]) {
-            advice.push("fix = [\"v1\", \"v2\"] on a point group and fix = [\"v2\"] on a second point, or symmetry conditions (symmetry_x1, symmetry_x2 on symmetry edges)");
+            advice.push("fix = [\"v1-\", \"v2-\"] on a point group and fix = [\"v2-\"] on a second point along x1 from it (one face: \"v1\" and \"v2\" hold both faces, which also clamps the fibre's rotation there), or symmetry conditions (symmetry_x1, symmetry_x2 on symmetry edges)");
         }
         if involves(&[2, 3, 4]) {
             advice.push("fix = [\"simply_supported\"] on an edge or on three points not in a line, or a punch touching the plate at the start");

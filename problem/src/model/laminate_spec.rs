@@ -13,6 +13,7 @@
 //! surfaces = 4              # in each layer
 //! ```
 
+use crate::schema::limits::{MAX_MAGNITUDE, MIN_MAGNITUDE};
 use crate::schema::{num, OneOrThree, Problem};
 use stamp::Result;
 use stamp_elements::{Isotropic, Laminate, Orthotropic, Ply, PlyMaterial};
@@ -30,6 +31,19 @@ fn materials(p: &Problem) -> Result<Vec<(String, PlyMaterial)>> {
         }
         if out.iter().any(|(n, _)| *n == spec.name) {
             return Err(err(".name", format!("two materials are named '{}'", stamp::quote(&spec.name))));
+        }
+        // the ranges of [plate]'s E (a modulus of 1e-300 or 1e300 ended "converged" undeformed or
+        // in NaN after 12 cut-backs)
+        let moduli = |v: &OneOrThree| -> Vec<f64> {
+            match v {
+                OneOrThree::One(x) => vec![*x],
+                OneOrThree::Three(x) => x.to_vec(),
+            }
+        };
+        for (k, v) in std::iter::once(("E", &spec.young)).chain(spec.shear.as_ref().map(|g| ("G", g))) {
+            if let Some(bad) = moduli(v).into_iter().find(|x| !(MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(x)) {
+                return Err(err(&format!(".{k}"), format!("expected positive moduli from {MIN_MAGNITUDE:e} to {MAX_MAGNITUDE:e} (the range of [plate] E), got {}", num(bad))));
+            }
         }
         let material = match (&spec.young, &spec.shear, &spec.nu) {
             (OneOrThree::One(e), None, OneOrThree::One(nu)) => PlyMaterial::Isotropic(Isotropic::new(*e, *nu).map_err(|e| err("", e.to_string()))?),
@@ -88,7 +102,7 @@ pub fn laminate(p: &Problem) -> Result<Option<(Laminate, usize)>> {
     let per_layer = match ps.surfaces {
         Some(n) if (3..=5).contains(&n.0) => n.0,
         Some(n) => return Err(p.error_at(s.plate.span(), "plate.surfaces", format!("with layers, the surfaces in each layer (its faces included): 3 to 5, got {}", n.0))),
-        None => return Err(p.error_at(s.plate.span(), "plate.surfaces", "with layers, give `surfaces` = 3 to 5, the surfaces in each layer (its faces included; 5 for stresses within 1 % of 3D elasticity on thick plates, docs/verification.md)")),
+        None => return Err(p.error_at(s.plate.span(), "plate.surfaces", "with layers, give `surfaces` = 3 to 5, the surfaces in each layer (its faces included; 5 for stresses within 1 % of 3D elasticity on thick plates, docs/verification/laminates.md)")),
     };
     let materials = materials(p)?;
     let list = layers.get_ref();
@@ -102,8 +116,8 @@ pub fn laminate(p: &Problem) -> Result<Option<(Laminate, usize)>> {
     for (k, l) in list.iter().enumerate() {
         let spec = l.get_ref();
         let key = format!("plate.layers[{k}]");
-        if !(spec.thickness.is_finite() && spec.thickness > 0.0 && spec.thickness <= 1e100) {
-            return Err(p.error_at(l.span(), &format!("{key}.thickness"), format!("must be positive and finite, got {}", num(spec.thickness))));
+        if !(MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&spec.thickness) {
+            return Err(p.error_at(l.span(), &format!("{key}.thickness"), format!("must be a positive length from {MIN_MAGNITUDE:e} to {MAX_MAGNITUDE:e} (the range of [plate] thickness), got {}", num(spec.thickness))));
         }
         if !(spec.angle.is_finite() && spec.angle.abs() <= 1e6) {
             return Err(p.error_at(l.span(), &format!("{key}.angle"), format!("must be a finite angle in degrees, got {}", num(spec.angle))));

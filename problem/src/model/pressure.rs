@@ -2,6 +2,7 @@
 //! x1, x2 with the syntax of a punch's `psi` (stamp_contact's parser), evaluated at the reference
 //! positions of the Gauss points and turned into consistent nodal forces int N_a q dA.
 
+use crate::schema::limits::MAX_MAGNITUDE;
 use crate::schema::{PressureSpec, Problem};
 use stamp::Result;
 use stamp::mesh::{bilinear, bilinear_jacobian, QuadMesh};
@@ -36,6 +37,11 @@ pub fn nodal_forces(p: &Problem, span: std::ops::Range<usize>, key: &str, mesh: 
             let v = q(at(0), at(1));
             if !v.is_finite() {
                 return Err(p.error_at(span, key, format!("the pressure is {v} at (x1, x2) = ({}, {}), a point of the loaded group", at(0), at(1))));
+            }
+            // the range of a pressure written as a number ("1.7e308" summed to -inf nodal forces,
+            // "1e300" to NaN in the solve)
+            if v.abs() > MAX_MAGNITUDE {
+                return Err(p.error_at(span, key, format!("the pressure is {v:e} at (x1, x2) = ({}, {}), a point of the loaded group: beyond {MAX_MAGNITUDE:e}, the largest magnitude a number may have", at(0), at(1))));
             }
             for a in 0..4 {
                 f[mesh.cells[c][a]] += n[a] * v * det;

@@ -14,7 +14,7 @@
 //! mirror images of its cells too, as the whole plate's probe would: the components odd under the
 //! mirror (u1, s12, s13 for x1; u2, s12, s23 for x2) average to zero there. At an interface the
 //! transverse stresses of the two layers differ by what the model has not converged
-//! (docs/verification.md measures it against Pagano's exact solution).
+//! (docs/verification/laminates.md measures it against Pagano's exact solution).
 
 use crate::model::mesh::MeshData;
 use crate::model::plate_model::Plate;

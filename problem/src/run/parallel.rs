@@ -131,10 +131,49 @@ pub fn agreed_interrupt() -> Option<Box<dyn Fn(bool) -> bool>> {
 /// linear solver is told the same owners, so that each rank's rows of the distributed matrices are
 /// mostly its own elements' entries. On one rank, with fewer elements than ranks, or without the
 /// feature `petsc`: nothing (every rank evaluates the whole model).
-pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, linear: &mut Linear) -> Result<()> {
+/// A hash of what a rank solves: the problem file's text (or the table a dict was turned into)
+/// and the mesh's coordinates and cells (a gmsh file read beside it). The ranks compare it before
+/// they share the model: ranks whose problem files differ (E on one rank, another punch force)
+/// deadlocked after the first Newton iteration or ignored the difference.
+pub fn inputs_hash(p: &Problem, mesh: &stamp::mesh::QuadMesh) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    eat(p.source.as_bytes());
+    for x in &mesh.coords {
+        eat(&x[0].to_bits().to_le_bytes());
+        eat(&x[1].to_bits().to_le_bytes());
+    }
+    for c in &mesh.cells {
+        for &n in c {
+            eat(&(n as u64).to_le_bytes());
+        }
+    }
+    h
+}
+
+/// Every rank's [`inputs_hash`] the same, or the error that stops them all (collective).
+#[cfg(feature = "petsc")]
+fn same_inputs(petsc: &stamp_petsc::Petsc, h: u64) -> Result<()> {
+    let (mut hi, mut lo) = ([h], [h]);
+    petsc.max_u64(&mut hi)?;
+    petsc.min_u64(&mut lo)?;
+    if hi != lo {
+        return Err(stamp::StampError::Problem(format!(
+            "the ranks read different problems (rank {} read one whose problem file or mesh hashes to {h:016x}; another rank's differs): every rank must read the same problem file and mesh",
+            petsc.rank()
+        )));
+    }
+    Ok(())
+}
+
+pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, linear: &mut Linear, inputs: u64) -> Result<()> {
     #[cfg(not(feature = "petsc"))]
     {
-        let _ = (model, linear);
+        let _ = (model, linear, inputs);
         Ok(())
     }
     #[cfg(feature = "petsc")]
@@ -145,6 +184,7 @@ pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, lin
         if p <= 1 {
             return Ok(());
         }
+        same_inputs(&petsc, inputs)?;
         let (ne, nn) = (model.element.num_elements(), model.dofs.num_nodes());
         if ne < p {
             // fewer elements than ranks: every rank evaluates the whole model

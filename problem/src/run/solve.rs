@@ -400,7 +400,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         crate::run::parallel::linear_solver(p, &mesh.mesh.coords, model.dofs.equations(), model.dofs.dofs_per_node(), inner, z)?
     };
     // on P > 1 ranks each evaluates its own elements (see parallel.rs)
-    crate::run::parallel::share(&mut model, &mut linear)?;
+    crate::run::parallel::share(&mut model, &mut linear, crate::run::parallel::inputs_hash(p, &mesh.mesh))?;
     let mut summary = Summary {
         ranks,
         linear_solver: crate::run::parallel::describe(&linear),

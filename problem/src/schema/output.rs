@@ -132,7 +132,7 @@ pub struct OutputSpec {
     /// Every converged step (true) or the targets only (false).
     #[serde(default = "yes")]
     pub every_step: bool,
-    /// A node is in the loaded zone when |lambda| > loaded_threshold * max |lambda| (0.5 %: docs/verification.md,
+    /// A node is in the loaded zone when |lambda| > loaded_threshold * max |lambda| (0.5 %: docs/verification/paper.md,
     /// "The paper's benchmark").
     #[serde(default = "default_threshold")]
     pub loaded_threshold: Fraction,

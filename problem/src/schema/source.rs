@@ -29,11 +29,13 @@ pub(super) fn toml_message(source: &str, e: &toml::de::Error) -> String {
     // (toml may point inside the value, at the unit of `2e4MPa`: back to the value's start)
     let before = source.get(..span.start).unwrap_or("");
     let value_start = before.trim_end_matches(|c: char| c.is_ascii_digit() || matches!(c, '.' | '+' | '-' | '_' | 'e' | 'E')).len();
-    let what = match number_with_unit(source.get(value_start..).unwrap_or("")) {
+    // `E = "210 GPa"`: serde says "invalid type: string"; the value is the same mistake
+    let quoted = what.starts_with("invalid type: string").then(|| source.get(span.start..).and_then(|t| t.strip_prefix('"')).unwrap_or("")).filter(|t| !t.is_empty());
+    let what = match number_with_unit(quoted.unwrap_or(source.get(value_start..).unwrap_or(""))) {
         Some((number, unit)) => format!(
-            "'{}' is a number followed by a unit: values are plain numbers in the file's own consistent units (write {}); unit names are labels, given once in [units] (length, force, pressure)",
+            "'{}' is a number followed by a unit: values are plain numbers in the units the whole file uses, and stamp converts nothing ([units] only labels the outputs){}",
             quote(&format!("{number} {unit}")),
-            quote(number)
+            converted(source, number, unit)
         ),
         None => what,
     };
@@ -54,6 +56,60 @@ pub(super) fn toml_message(source: &str, e: &toml::de::Error) -> String {
     format!("line {line}, column {col}: {what}\n{}", source_window(source, line, col))
 }
 
+/// Known units as (name, kind in [units], factor to SI).
+const KNOWN_UNITS: &[(&str, &str, f64)] = &[
+    ("Pa", "pressure", 1.0),
+    ("kPa", "pressure", 1e3),
+    ("MPa", "pressure", 1e6),
+    ("GPa", "pressure", 1e9),
+    ("N/mm^2", "pressure", 1e6),
+    ("N/mm2", "pressure", 1e6),
+    ("N/m^2", "pressure", 1.0),
+    ("mN", "force", 1e-3),
+    ("N", "force", 1.0),
+    ("kN", "force", 1e3),
+    ("MN", "force", 1e6),
+    ("um", "length", 1e-6),
+    ("mm", "length", 1e-3),
+    ("cm", "length", 1e-2),
+    ("m", "length", 1.0),
+    ("km", "length", 1e3),
+];
+
+/// The value the file should hold for `number unit`: converted into the unit its `[units]` table
+/// gives for that kind ("; with [units] pressure = \"MPa\": write 210000"), or advice to convert
+/// by hand when the file names none (the number alone would be read in the file's units, which
+/// is how `E = 210` in a file of MPa made a plate 1000 times too soft).
+fn converted(source: &str, number: &str, unit: &str) -> String {
+    let Some(&(_, kind, factor)) = KNOWN_UNITS.iter().find(|u| u.0 == unit) else {
+        return ": write the number converted into the units of the rest of the file".to_string();
+    };
+    let file_unit = file_units(source).into_iter().find(|(k, _)| k == kind).map(|(_, u)| u);
+    let value: Option<f64> = number.replace('_', "").parse().ok();
+    match (file_unit.as_deref().and_then(|u| KNOWN_UNITS.iter().find(|k| k.0 == u && k.1 == kind)), value) {
+        (Some(&(name, _, to)), Some(v)) => format!(": with [units] {kind} = \"{name}\", write {}", v * factor / to),
+        _ => format!(": write it converted into the file's {kind} unit (e.g. {} {unit} is {} in MPa), and name that unit in [units] {kind}", number, value.map(|v| v * factor / 1e6).unwrap_or(f64::NAN)),
+    }
+}
+
+/// The `[units]` table's entries (kind, unit) read from the text (the file may not parse as a
+/// whole: this is for an error's advice).
+fn file_units(source: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut inside = false;
+    for line in source.lines() {
+        let t = line.split('#').next().unwrap_or("").trim();
+        if t.starts_with('[') {
+            inside = t == "[units]";
+            continue;
+        }
+        if let (true, Some((k, v))) = (inside, t.split_once('=')) {
+            out.push((k.trim().to_string(), v.trim().trim_matches('"').to_string()));
+        }
+    }
+    out
+}
+
 /// A value written as a number followed by a unit word (`210 GPa`, `2mm`, `0.05 N/mm`): the
 /// number and the unit, else None. `text` starts at the value.
 fn number_with_unit(text: &str) -> Option<(&str, &str)> {
@@ -62,7 +118,7 @@ fn number_with_unit(text: &str) -> Option<(&str, &str)> {
     // the longest prefix that is a number ("2e4MPa": "2e4"; "5em": "5")
     let (number, rest) = (1..=end).rev().map(|k| line.split_at(k)).find(|(n, _)| n.replace('_', "").parse::<f64>().is_ok())?;
     let rest = rest.trim_start();
-    let unit_end = rest.find(|c: char| c.is_whitespace() || matches!(c, ',' | ']' | '}' | '#')).unwrap_or(rest.len());
+    let unit_end = rest.find(|c: char| c.is_whitespace() || matches!(c, ',' | ']' | '}' | '#' | '"')).unwrap_or(rest.len());
     let unit = &rest[..unit_end];
     unit.chars().next().is_some_and(|c| c.is_alphabetic() || c == '%').then_some((number, unit))
 }
