@@ -283,7 +283,7 @@ mod tests {
     #[test]
     fn the_smoothing_damps_a_checkerboard_and_the_projection_amplifies_it() {
         let n = 12;
-        let board = move |k: usize, _: f64, _: f64| 1.0 + 0.1 * if (k % (n + 1) + k / (n + 1)) % 2 == 0 { 1.0 } else { -1.0 };
+        let board = move |k: usize, _: f64, _: f64| 1.0 + 0.1 * if (k % (n + 1) + k / (n + 1)).is_multiple_of(2) { 1.0 } else { -1.0 };
         let (p, cells) = pair(n, board);
         let q = p.pressures();
         // the amplitude of the checkerboard at the nodes away from the edge
