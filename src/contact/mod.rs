@@ -31,7 +31,8 @@
 //! its gradient at a point; `normal_law.rs` the frictionless law of one point (its multiplier and
 //! its tangent); `evaluate.rs` one evaluation of every point; `nodal.rs` the paper's collocation
 //! at the nodes; `integrated.rs` the integrated discretisation on a [`ContactFace`];
-//! `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
+//! `recover.rs` the recovered pressure field
+//! written beside the nodal one; `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
 //! `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves; `share.rs` the points
 //! of one process.
 
@@ -44,12 +45,14 @@ mod kinematics;
 mod motion;
 mod nodal;
 mod normal_law;
+mod recover;
 mod regularisation;
 mod share;
 pub use constraint::{ContactKinematics, ContactPair, ContactPoint, PointState};
 pub use face::ContactFace;
 pub use first_touch::{CONVERGING_TENSION, DEEP_ENTRY_RATIO, ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 pub use motion::{ForceDrive, PunchMotion};
+pub use recover::{recovered_pressure, RecoveredPressure, Recovery, RECOVERY};
 pub use regularisation::{automatic_eps_reg, AUTO_EPS_FACTOR};
 pub use share::PointShare;
 

@@ -4,10 +4,13 @@
 //!
 //! Point data: `displacement` = mid-surface (v- + v+)/2, `displacement_bottom` = v-,
 //! `displacement_top` = v+ (3-vectors); `lambda` (the multiplier, <= 0 in contact, force per unit
-//! reference area), `contact_pressure` q_n = -lambda |grad Psi| >= 0, `gap` = Psi / |grad Psi| of the
+//! reference area), `contact_pressure` q_n = -lambda |grad Psi| >= 0, `contact_pressure_recovered`
+//! (a continuous field made from the nodal forces, [`stamp::contact::recovered_pressure`] with
+//! [`stamp::contact::RECOVERY`]), `gap` = Psi / |grad Psi| of the
 //! face each punch touches (the smallest over the punches; written only when there are punches),
 //! `active` (1 in the active set), `loaded` (1 where |lambda| > loaded_threshold * max |lambda| of
-//! that punch). A node that is a candidate of several punches gets the sum of their lambda and q_n.
+//! that punch). A node that is a candidate of several punches gets the sum of their lambda, q_n and
+//! recovered pressure.
 //!
 //! Cell data (element centre = mean over the 2 x 2 Gauss points of the element's assumed resultants;
 //! for the nonlinear plate these are second Piola-Kirchhoff resultants per unit reference length):
@@ -31,7 +34,7 @@ use stamp_elements::{Face, Section};
 use std::collections::BTreeMap;
 
 /// Names of the point arrays of every .vtu (gap only with punches).
-pub const POINT_ARRAYS: [&str; 8] = ["displacement", "displacement_bottom", "displacement_top", "lambda", "contact_pressure", "gap", "active", "loaded"];
+pub const POINT_ARRAYS: [&str; 9] = ["displacement", "displacement_bottom", "displacement_top", "lambda", "contact_pressure", "contact_pressure_recovered", "gap", "active", "loaded"];
 /// Names of the cell arrays of every .vtu.
 pub const CELL_ARRAYS: [&str; 9] = ["N11", "N22", "N12", "M11", "M22", "M12", "Q1", "Q2", "T33"];
 
@@ -256,6 +259,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
     let coords = &cx.mesh.mesh.coords;
     let mut lambda = vec![0.0; n];
     let mut pressure = vec![0.0; n];
+    let mut recovered = vec![0.0; n];
     let mut active = vec![0.0; n];
     let mut loaded = vec![0.0; n];
     let mut gap = vec![f64::INFINITY; n];
@@ -266,6 +270,10 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
     let mut punch_rows = Vec::new();
     for (info, pair) in cx.punches.iter().zip(&model.contacts) {
         let q = pair.pressures();
+        let p_rec = stamp::contact::recovered_pressure(pair, &cx.mesh.mesh.cells, stamp::contact::RECOVERY).pressure;
+        for (pt, v) in pair.points.iter().zip(&p_rec) {
+            recovered[pt.node] += v;
+        }
         let lam_max = pair.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
         let mut candidate = vec![false; n];
         let mut p_loaded = Vec::new();
@@ -344,6 +352,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         Field::new("displacement_top", 3, (0..n).flat_map(|k| face_disp(u, k, Face::Top)).collect()),
         Field::scalar("lambda", lambda),
         Field::scalar("contact_pressure", pressure),
+        Field::scalar("contact_pressure_recovered", recovered),
     ];
     if !cx.punches.is_empty() {
         let big = gap.iter().cloned().filter(|g| g.is_finite()).fold(0.0, f64::max);

@@ -15,6 +15,9 @@
 //! as markers); points outside the mesh are left out of the CSV and the plot. Per written step `probe_<name>_<step>.csv` has the columns
 //! `distance` (from `from`), `x1`, `x2` (reference), `u1`, `u2`, `u3` (mid-surface displacement)
 //! and, for each punch, `<punch>_pressure` (the contact pressure, the paper's q_n),
+//! `<punch>_pressure_recovered` (the recovered pressure of the .vtu's
+//! `contact_pressure_recovered`, a continuous field made from the nodal forces, smoother than
+//! q_n node to node on cut triangles: [`stamp::contact::recovered_pressure`]),
 //! `<punch>_integral` (the integral of the pressure along the line from `from` to the point, by
 //! the trapezoidal rule over the points) and `<punch>_line_load` (the same integral of the
 //! pressure averaged across a band of [`BAND_CELLS`] cell sizes centred on the line). Across a
@@ -286,6 +289,16 @@ pub fn nodal_pressure(pair: &ContactPair, num_nodes: usize) -> Vec<f64> {
     q
 }
 
+/// The recovered contact pressure of one punch ([`stamp::contact::RECOVERY`]) at every node (0
+/// at nodes that are not its candidates).
+pub fn recovered_nodal_pressure(pair: &ContactPair, cells: &[[usize; 4]], num_nodes: usize) -> Vec<f64> {
+    let mut q = vec![0.0; num_nodes];
+    for (pt, v) in pair.points.iter().zip(stamp::contact::recovered_pressure(pair, cells, stamp::contact::RECOVERY).pressure) {
+        q[pt.node] += v;
+    }
+    q
+}
+
 /// One written step of a probe, kept for the plot.
 struct Curve {
     row: HistoryRow,
@@ -388,15 +401,17 @@ impl<'a> Probes<'a> {
         self.place_default(contacts);
         let nn = self.mesh.num_nodes();
         let q: Vec<Vec<f64>> = contacts.iter().map(|c| nodal_pressure(c, nn)).collect();
+        let rec: Vec<Vec<f64>> = contacts.iter().map(|c| recovered_nodal_pressure(c, &self.mesh.cells, nn)).collect();
         let mut files = Vec::new();
         for (line, curves) in self.lines.iter().zip(&mut self.curves) {
             let disp: Vec<Vec<f64>> = (0..3).map(|i| line.interpolate(|n| layout.mid_displacement(u, n)[i])).collect();
             let qs: Vec<Vec<f64>> = q.iter().map(|qk| line.interpolate(|n| qk[n])).collect();
+            let recs: Vec<Vec<f64>> = rec.iter().map(|rk| line.interpolate(|n| rk[n])).collect();
             let integrals: Vec<Vec<f64>> = qs.iter().map(|v| line.running_integral(v)).collect();
             let loads: Vec<Vec<f64>> = q.iter().map(|qk| line.running_integral(&line.band_mean(|n| qk[n]))).collect();
             let mut csv = String::from("distance,x1,x2,u1,u2,u3");
             for n in punch_names {
-                csv.push_str(&format!(",{n}_pressure,{n}_integral,{n}_line_load"));
+                csv.push_str(&format!(",{n}_pressure,{n}_pressure_recovered,{n}_integral,{n}_line_load"));
             }
             csv.push('\n');
             let mut points = Vec::with_capacity(line.samples.len());
@@ -404,8 +419,8 @@ impl<'a> Probes<'a> {
             for (k, s) in line.samples.iter().enumerate() {
                 csv.push_str(&format!("{:e},{:e},{:e},{:e},{:e},{:e}", s.distance, s.x[0], s.x[1], disp[0][k], disp[1][k], disp[2][k]));
                 let mut total = 0.0;
-                for ((qk, ik), lk) in qs.iter().zip(&integrals).zip(&loads) {
-                    csv.push_str(&format!(",{:e},{:e},{:e}", qk[k], ik[k], lk[k]));
+                for (((qk, rk), ik), lk) in qs.iter().zip(&recs).zip(&integrals).zip(&loads) {
+                    csv.push_str(&format!(",{:e},{:e},{:e},{:e}", qk[k], rk[k], ik[k], lk[k]));
                     total += qk[k];
                 }
                 csv.push('\n');
