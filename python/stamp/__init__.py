@@ -101,7 +101,7 @@ class Problem:
     docs/problem-file.md: ``mesh``, ``plate``, ``boundary``, ``load``, ``punch``, ``solver``,
     ``output``, ``units``, ``title``); the dict is turned into the same TOML table and checked by
     the same code, so a bad value raises :class:`StampError` with the message ``stamp run`` gives
-    for it, naming the key (its line numbers point into :attr:`toml`). Values may be numbers,
+    for it, naming the key (``in the table: plate.nu: ...``, no line numbers). Values may be numbers,
     strings, bools, lists, tuples, dicts and numpy arrays or scalars.
 
     The mesh is ``{"file": "plate.msh"}`` (a gmsh file, relative to the working directory),

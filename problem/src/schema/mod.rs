@@ -79,6 +79,17 @@ pub struct Problem {
     /// A mesh given in memory (the Python package's arrays, [`stamp::io::mesh_from_arrays`]) in
     /// place of `[mesh] file` or `rectangle`.
     pub given_mesh: Option<std::sync::Arc<stamp::io::GmshMesh>>,
+    /// Built from a table in memory (the Python package's dict): errors name the keys alone, not
+    /// lines of a TOML text the user never saw.
+    pub from_table: bool,
+}
+
+/// A message of the problem file's text for a problem given as a table: without "line L,
+/// column C: " and without the line shown under it, so that it names the key alone.
+fn keys_only(message: &str) -> String {
+    let first = message.split("\n  ").next().unwrap_or(message);
+    let rest = first.strip_prefix("line ").and_then(|r| r.split_once(": ").filter(|(place, _)| place.contains("column")).map(|(_, rest)| rest));
+    format!("in the table: {}", rest.unwrap_or(first))
 }
 
 impl Problem {
@@ -117,23 +128,26 @@ impl Problem {
     /// (the table's `mesh` then has neither).
     pub fn from_table(path: &Path, table: toml::Table, mesh: Option<stamp::io::GmshMesh>) -> Result<Problem> {
         let source = toml::to_string(&table).map_err(|e| StampError::Input { file: path.display().to_string(), message: format!("cannot be written as TOML: {e}") })?;
-        Problem::parse_with_mesh(path, source, mesh.map(std::sync::Arc::new))
+        Problem::parse_with_mesh(path, source, mesh.map(std::sync::Arc::new), true)
     }
 
     /// Parse problem text (`path` names it in errors and anchors relative paths).
     pub fn parse(path: &Path, source: String) -> Result<Problem> {
-        Problem::parse_with_mesh(path, source, None)
+        Problem::parse_with_mesh(path, source, None, false)
     }
 
-    fn parse_with_mesh(path: &Path, source: String, given_mesh: Option<std::sync::Arc<stamp::io::GmshMesh>>) -> Result<Problem> {
+    fn parse_with_mesh(path: &Path, source: String, given_mesh: Option<std::sync::Arc<stamp::io::GmshMesh>>, from_table: bool) -> Result<Problem> {
         if source.trim_start().starts_with("$MeshFormat") {
             return Err(StampError::Input {
                 file: path.display().to_string(),
                 message: "this is a gmsh mesh, not a problem file: write a problem file (TOML) whose [mesh] file = names it".into(),
             });
         }
-        let spec: ProblemFile = toml::from_str(&source).map_err(|e| StampError::Input { file: path.display().to_string(), message: toml_message(&source, &e) })?;
-        let p = Problem { path: path.to_path_buf(), source, spec, given_mesh };
+        let spec: ProblemFile = toml::from_str(&source).map_err(|e| {
+            let message = toml_message(&source, &e);
+            StampError::Input { file: path.display().to_string(), message: if from_table { keys_only(&message) } else { message } }
+        })?;
+        let p = Problem { path: path.to_path_buf(), source, spec, given_mesh, from_table };
         p.check()?;
         Ok(p)
     }
@@ -145,6 +159,9 @@ impl Problem {
 
     /// An input error located at `span`, naming `key`.
     pub fn error_at(&self, span: std::ops::Range<usize>, key: &str, message: impl std::fmt::Display) -> StampError {
+        if self.from_table {
+            return StampError::Input { file: self.path.display().to_string(), message: format!("in the table: {key}: {message}") };
+        }
         let (line, col) = self.line_col(span.start);
         StampError::Input { file: self.path.display().to_string(), message: format!("line {line}, column {col}: {key}: {message}\n{}", source_window(&self.source, line, col)) }
     }
@@ -191,6 +208,23 @@ mod tests {
 
     fn table(text: &str) -> toml::Table {
         toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn a_table_s_errors_name_its_keys_not_lines_of_its_toml() {
+        let mut plate = toml::Table::new();
+        plate.insert("nu".into(), toml::Value::Float(0.5));
+        let mut t = toml::Table::new();
+        t.insert("plate".into(), toml::Value::Table(plate));
+        let e = Problem::from_table(Path::new("problem"), t.clone(), None).unwrap_err().to_string();
+        assert!(e.contains("in the table: plate") && !e.contains("line ") && !e.contains(" | "), "{e}");
+        // a type error of serde's, and an unknown key
+        t["plate"].as_table_mut().unwrap().insert("nu".into(), toml::Value::String("x".into()));
+        let e = Problem::from_table(Path::new("problem"), t.clone(), None).unwrap_err().to_string();
+        assert!(e.contains("in the table: ") && !e.contains("column") && !e.contains(" | "), "{e}");
+        // the same table as a file: its lines
+        let e = Problem::parse(Path::new("p.toml"), "[plate]\nnu = 0.5\n".into()).unwrap_err().to_string();
+        assert!(e.contains("line 2, column"), "{e}");
     }
 
     #[test]
