@@ -532,3 +532,32 @@ rel_tol = 1e-11
     let (a, c) = (results[0].last().unwrap(), results[2].last().unwrap());
     assert!((a.1 + c.1).abs() > 1e-5 * a.1.abs(), "force {} against {}", a.1, c.1);
 }
+
+/// `transverse_shear = "equilibrium"` in the cell next but one to a symmetry plane: the quarter
+/// plate's probe reads what the half plate's reads at the same point (the fit's patch unfolded
+/// across the plane; before, the quarter's patch stopped at the plane and its s13 was 9 % off).
+#[test]
+fn equilibrium_shear_near_a_symmetry_plane_reads_as_on_the_larger_model() {
+    let dir = temp_dir("laminate-equilibrium-symmetry");
+    let probe = "\n[[output.thickness_probe]]\nname = \"near\"\nat = [4.0625, 1.5625]\ntransverse_shear = \"equilibrium\"\n";
+    let quarter = pagano_problem(8, 3) + probe;
+    // the half plate [0, 10] x [0, 5]: diaphragms on x1 = 0 and 10, the symmetry plane x2 = 5
+    let half = quarter
+        .replace("x = [0.0, 5.0], y = [0.0, 5.0], n = [8, 8]", "x = [0.0, 10.0], y = [0.0, 5.0], n = [16, 8]")
+        .replace("group = \"right\"\nfix = [\"symmetry_x1\"]", "group = \"right\"\nfix = [\"v2\", \"v3\"]");
+    assert_ne!(half, quarter);
+    let mut tables = Vec::new();
+    for (name, text) in [("quarter", &quarter), ("half", &half)] {
+        let path = write(&dir, &format!("{name}.toml"), text);
+        let out = dir.join(name);
+        stamp_cli::run::run(&path, Some(&out), true).unwrap();
+        tables.push(read_csv(&out.join("thickness_near_0001.csv")));
+    }
+    let largest = tables[1].iter().map(|r| r[9].abs()).fold(0.0, f64::max);
+    assert!(largest > 0.0);
+    for (q, h) in tables[0].iter().zip(&tables[1]) {
+        for c in [9, 10] {
+            assert!((q[c] - h[c]).abs() <= 1e-6 * largest, "x3 = {}: column {c}: quarter {} half {}", q[0], q[c], h[c]);
+        }
+    }
+}

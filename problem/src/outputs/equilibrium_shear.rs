@@ -6,8 +6,8 @@
 //! from the free bottom face (no shear traction there: pressures and frictionless contact are
 //! normal; linear equilibrium, so for small strains). The in-plane derivatives come from a
 //! recovery: at each height, a least-squares quadratic in (x1, x2) through the in-plane stresses
-//! at the centres of the cells around the point (those that hold it and two rings of neighbours,
-//! with their mirror images across the symmetry planes through the point, s12 odd there); its
+//! at the centres of the cells around the point (those that hold it and two rings of neighbours on
+//! the plate unfolded across its symmetry planes, s12 odd under a mirror); its
 //! linear terms are the derivatives at the point. Centres, not Gauss points: the element's
 //! membrane strain E11 is constant along x1 in a cell (and E22 along x2), so its Gauss points
 //! form a staircase whose fitted slope is biased low (by a quarter on two cells); the centre
@@ -36,33 +36,85 @@ pub struct ShearRecovery {
 }
 
 impl ShearRecovery {
-    /// The patch around `at` held by `holding` (cells) and two rings of neighbours, mirrored
-    /// across the planes of `mirror`.
+    /// The patch around `at`: the cells that hold it and two rings of neighbours, on the plate
+    /// unfolded across its symmetry planes (`planes[d]`: the coordinates x_(d+1) of the planes of
+    /// normal x_(d+1)): a cell that touches a plane has its mirror image as a neighbour, so that a
+    /// point near a symmetry plane (not only on it) is fitted from the cells the whole plate would
+    /// give (a probe two cells from the plane read s13 9 % apart on a quarter and a half model).
+    /// `holding` are the cells that hold `at`; their images that hold it too (a point on a plane)
+    /// start the patch with them.
     /// None when the cells' centres do not determine a quadratic (too few, or in a line: a strip
     /// one cell wide).
-    pub fn new(mesh: &QuadMesh, holding: &[usize], at: [f64; 2], mirror: [bool; 2]) -> Option<ShearRecovery> {
-        let mut cells: Vec<usize> = holding.to_vec();
-        for _ring in 0..2 {
-            let nodes: Vec<usize> = cells.iter().flat_map(|&c| mesh.cells[c]).collect();
-            for (c, cell) in mesh.cells.iter().enumerate() {
-                if cell.iter().any(|n| nodes.contains(n)) && !cells.contains(&c) {
-                    cells.push(c);
+    pub fn new(mesh: &QuadMesh, holding: &[usize], at: [f64; 2], planes: &[Vec<f64>; 2]) -> Option<ShearRecovery> {
+        let tol = 1e-9 * mesh.element_size();
+        // for each axis, the plane nearest the point (a patch two rings wide reaches one)
+        let plane: [Option<f64>; 2] = std::array::from_fn(|d| planes[d].iter().copied().min_by(|a, b| (a - at[d]).abs().total_cmp(&(b - at[d]).abs())));
+        // (cell, image: mirrored across x1's plane, across x2's)
+        let mut patch: Vec<(usize, [bool; 2])> = Vec::new();
+        for &c in holding {
+            for img in [[false, false], [true, false], [false, true], [true, true]] {
+                // an image holds the point when the point is on the planes it mirrors across
+                if (0..2).all(|d| !img[d] || plane[d].is_some_and(|p| (at[d] - p).abs() <= tol)) && !patch.contains(&(c, img)) {
+                    patch.push((c, img));
                 }
             }
         }
-        let size = mesh.element_size();
-        // (cell index, centre relative to `at` / size, sign of s12 by image)
-        let mut samples = Vec::new();
-        for (i, &c) in cells.iter().enumerate() {
-            let x = mesh.cell_coords(c);
-            let pos: [f64; 2] = std::array::from_fn(|d| (0.25 * (0..4).map(|a| x[a][d]).sum::<f64>() - at[d]) / size);
-            for (mx, my) in [(false, false), (true, false), (false, true), (true, true)] {
-                if (mx && !mirror[0]) || (my && !mirror[1]) {
-                    continue;
-                }
-                let image = [if mx { -pos[0] } else { pos[0] }, if my { -pos[1] } else { pos[1] }];
-                samples.push((i, image, if mx != my { -1.0 } else { 1.0 }));
+        let mut node_cells: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
+        for (c, cell) in mesh.cells.iter().enumerate() {
+            for &n in cell {
+                node_cells.entry(n).or_default().push(c);
             }
+        }
+        for _ring in 0..2 {
+            let mut next = patch.clone();
+            for &(c, img) in &patch {
+                let mut add = |x: (usize, [bool; 2])| {
+                    if !next.contains(&x) {
+                        next.push(x);
+                    }
+                };
+                for &n in &mesh.cells[c] {
+                    for &c2 in &node_cells[&n] {
+                        add((c2, img));
+                    }
+                }
+                // across a plane: the images of the cells that share a node on it (a node on
+                // the plane is its own image, so the images around it are neighbours too)
+                for d in 0..2 {
+                    let Some(p) = plane[d] else { continue };
+                    let mut flipped = img;
+                    flipped[d] = !flipped[d];
+                    for &n in mesh.cells[c].iter().filter(|&&n| (mesh.coords[n][d] - p).abs() <= tol) {
+                        for &c2 in &node_cells[&n] {
+                            add((c2, flipped));
+                        }
+                    }
+                }
+            }
+            patch = next;
+        }
+        let mut cells: Vec<usize> = Vec::new();
+        for &(c, _) in &patch {
+            if !cells.contains(&c) {
+                cells.push(c);
+            }
+        }
+        let size = mesh.element_size();
+        // (cell index, centre of the cell or its image relative to `at` / size, sign of s12 by
+        // image: odd under each mirror)
+        let mut samples = Vec::new();
+        for &(c, img) in &patch {
+            let i = cells.iter().position(|&x| x == c).expect("listed");
+            let x = mesh.cell_coords(c);
+            let pos: [f64; 2] = std::array::from_fn(|d| {
+                let centre = 0.25 * (0..4).map(|a| x[a][d]).sum::<f64>();
+                let centre = match (img[d], plane[d]) {
+                    (true, Some(p)) => 2.0 * p - centre,
+                    _ => centre,
+                };
+                (centre - at[d]) / size
+            });
+            samples.push((i, pos, if img[0] != img[1] { -1.0 } else { 1.0 }));
         }
         // least squares on [1, x, y, x^2, xy, y^2]: the rows of (A^T A)^-1 A^T for x and y
         let basis = |p: [f64; 2]| [1.0, p[0], p[1], p[0] * p[0], p[0] * p[1], p[1] * p[1]];

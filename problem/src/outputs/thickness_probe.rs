@@ -61,7 +61,7 @@ impl ThicknessProbes {
             let mirror = [0, 1].map(|d| on_symmetry_plane(p, mesh, spec.at, d));
             let recovery = if spec.transverse_shear.as_deref() == Some("equilibrium") {
                 let holding: Vec<usize> = cells.iter().map(|c| c.0).collect();
-                Some(ShearRecovery::new(&mesh.mesh, &holding, spec.at, mirror).ok_or_else(|| {
+                Some(ShearRecovery::new(&mesh.mesh, &holding, spec.at, &symmetry_planes(p, mesh)).ok_or_else(|| {
                     p.error_at(
                         s.span(),
                         &format!("output.thickness_probe[{i}].transverse_shear"),
@@ -87,6 +87,29 @@ impl ThicknessProbes {
         }
         Ok(files)
     }
+}
+
+/// The coordinates of the model's symmetry planes, by normal: [x1 of the planes of `symmetry_x1`
+/// groups, x2 of those of `symmetry_x2`] (a group whose nodes share one coordinate).
+fn symmetry_planes(p: &Problem, mesh: &MeshData) -> [Vec<f64>; 2] {
+    let tol = 1e-9 * mesh.element_size();
+    std::array::from_fn(|d| {
+        let word = if d == 0 { "symmetry_x1" } else { "symmetry_x2" };
+        let mut planes: Vec<f64> = Vec::new();
+        for b in &p.spec.boundary {
+            let b = b.get_ref();
+            if !b.fix.iter().any(|f| f.word == word) {
+                continue;
+            }
+            let Some(nodes) = mesh.nodes(b.group.get_ref()) else { continue };
+            let Some(&first) = nodes.first() else { continue };
+            let c = mesh.mesh.coords[first][d];
+            if nodes.iter().all(|&n| (mesh.mesh.coords[n][d] - c).abs() <= tol) && !planes.iter().any(|q| (q - c).abs() <= tol) {
+                planes.push(c);
+            }
+        }
+        planes
+    })
 }
 
 /// Whether `at` lies on a symmetry plane of normal x_(d+1): a boundary group fixed with
