@@ -5,6 +5,7 @@
 
 use super::first_touch::{ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 use super::kinematics::{Kinematics, SurfaceAtPoint};
+use super::friction_law::Friction;
 use super::{ContactFace, ForceDrive, PointShare, PunchMotion};
 use crate::surface::ContactSurface;
 use nalgebra::Vector3;
@@ -186,6 +187,8 @@ pub struct ContactPair {
     pub(super) last_trial: Vec<f64>,
     /// The points this process evaluates in a distributed run (see [`PointShare`]); None: all.
     pub(super) share: Option<PointShare>,
+    /// Coulomb friction ([`set_friction`](Self::set_friction)); None: frictionless.
+    pub friction: Option<Friction>,
 }
 
 impl ContactPair {
@@ -235,7 +238,31 @@ impl ContactPair {
             converged_scale: 0.0,
             last_trial: vec![0.0; n],
             share: None,
+            friction: None,
         }
+    }
+
+    /// Coulomb friction of coefficient `mu` between the body and this punch (docs/design.md,
+    /// "Friction"); 0: none (frictionless, the same operations as without this call). Nodal
+    /// contact with exact kinematics only, set after eps_reg (the tangential regularisation is
+    /// eps_reg |grad Psi|^2 where the punch touches).
+    pub fn set_friction(&mut self, mu: f64) -> crate::Result<()> {
+        if !(mu.is_finite() && mu >= 0.0) {
+            return Err(crate::StampError::Problem(format!("the friction coefficient must be a finite number >= 0, got {mu}")));
+        }
+        if mu == 0.0 {
+            self.friction = None;
+            return Ok(());
+        }
+        if self.face.is_some() {
+            return Err(crate::StampError::Problem("friction is implemented for the nodal contact scheme only, not the integrated one".into()));
+        }
+        if self.kinematics != ContactKinematics::Exact {
+            return Err(crate::StampError::Problem("friction needs the exact contact kinematics, not the shallow constraint".into()));
+        }
+        let g = self.contact_gradient_norm();
+        self.friction = Some(Friction::new(mu, self.eps_reg * g * g, self.points.iter().map(|p| p.x_ref)));
+        Ok(())
     }
 
     /// Evaluate only the points of `own` nodes from now on (`own[n]`: this process owns node n),
@@ -312,6 +339,14 @@ impl ContactPair {
                 self.lambda_bar[k] = self.state[k].lambda;
             }
         }
+        if self.friction.is_some() {
+            let share = self.share.take();
+            let evaluated = |k: usize| share.as_ref().is_none_or(|s| s.evaluated[k]);
+            if let Some(f) = &mut self.friction {
+                f.augment(evaluated);
+            }
+            self.share = share;
+        }
     }
 
     /// How far the augmented-Lagrangian multipliers are from converged, as a length: the largest
@@ -332,7 +367,11 @@ impl ContactPair {
                 if g > 0.0 { s.psi.abs() / g } else { 0.0 }
             })
             .fold(0.0, f64::max);
-        gaps.max(self.penetration_where(|k| self.owns(k)))
+        let violation = gaps.max(self.penetration_where(|k| self.owns(k)));
+        match &self.friction {
+            None => violation,
+            Some(f) => violation.max(f.stick_violation(|k| Vector3::from(self.state[k].grad).normalize(), |k| self.owns(k))),
+        }
     }
 
     /// The largest penetration max(0, -Psi) over the points, in units of Psi divided by
