@@ -1,0 +1,163 @@
+//! With Coulomb friction the assembled tangent of a model (plate plus a curved punch) is still the
+//! derivative of its residual: compared with central finite differences at a random
+//! large-displacement state where some points stick and some slip, with the punch moved by a
+//! prescribed displacement or pressed by a force (its travel an unknown).
+
+mod common;
+use common::*;
+use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive, SLIP, STICK};
+use stamp::dofs::DofMap;
+use stamp::mesh::QuadMesh;
+use stamp::model::Model;
+use stamp::nonlinear::NonlinearProblem;
+use stamp_contact::{Cylinder, Sphere};
+use stamp_elements::{Face, Kinematics, PlateElements};
+use std::sync::Arc;
+
+fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
+    let n = m.nrows();
+    let mut d = vec![vec![0.0; n]; n];
+    let (sym, vals) = m.parts();
+    for j in 0..n {
+        for (k, &i) in sym.row_idx()[sym.col_ptr()[j]..sym.col_ptr()[j + 1]].iter().enumerate() {
+            d[i][j] += vals[sym.col_ptr()[j] + k];
+        }
+    }
+    d
+}
+
+/// A distorted 3 x 3 plate pressed by `surface` at a random large-displacement state, friction
+/// `mu`, each point's anchor moved from where it stands by a random offset of 1e-5 to 1 (some
+/// stick, some slip) and a random tangential multiplier. Returns the model, evaluated once with
+/// the tangent there, and the state.
+fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>) -> (Model<PlateElements>, Vec<f64>) {
+    let mut mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 3, 3).unwrap();
+    let mut rng = Lcg(seed);
+    for n in 0..mesh.num_nodes() {
+        let x = mesh.coords[n];
+        if x[0] > 0.0 && x[0] < 2.0 && x[1] > 0.0 && x[1] < 2.0 {
+            mesh.coords[n] = [x[0] + rng.range(-0.15, 0.15), x[1] + rng.range(-0.15, 0.15)];
+        }
+    }
+    let section = steel_section(0.2);
+    let dp = section.delta_plus;
+    let plate = PlateElements::new(&mesh, section, Kinematics::Nonlinear).unwrap();
+    let mut dofs = DofMap::new(mesh.num_nodes(), 6).unwrap();
+    dofs.fix(mesh.group_nodes("left").unwrap(), &[0, 1, 2, 3, 4, 5]).unwrap();
+    let mut model = Model::new(plate, dofs).unwrap();
+    let areas = mesh.nodal_areas();
+    let points = (0..mesh.num_nodes())
+        .map(|n| ContactPoint { node: n, x_ref: [mesh.coords[n][0], mesh.coords[n][1], dp], dofs: [0, 1, 2].map(|c| Face::Top.dof(n, c)), weight: areas[n] })
+        .collect();
+    let mut pair = ContactPair::new("punch", surface, points, 3.0e3, ContactKinematics::Exact);
+    pair.entry_fraction = 0.0;
+    pair.gauss_newton_entry = false;
+    pair.motion = [0.01, -0.02, -0.05].into();
+    if let Some(n) = drive {
+        pair.drive = Some(ForceDrive::new(n, 7.0).unwrap());
+    }
+    pair.set_friction(mu).unwrap();
+    model.add_contact(pair);
+    let mut u: Vec<f64> = (0..model.num_dofs()).map(|_| rng.range(-0.3, 0.3)).collect();
+    for n in 0..mesh.num_nodes() {
+        for c in 0..3 {
+            let amplitude = if c == 2 { 1.0 } else { 1.0 / 3.0 };
+            u[Face::Top.dof(n, c)] *= amplitude;
+            u[Face::Bottom.dof(n, c)] = u[Face::Top.dof(n, c)] + 0.1 * u[Face::Bottom.dof(n, c)];
+        }
+    }
+    model.apply_prescribed(&mut u, 1.0);
+    model.evaluate(&u, 1.0, true).unwrap();
+    let f = model.contacts[0].friction.as_mut().unwrap();
+    for k in 0..f.anchor.len() {
+        let size = 10f64.powf(rng.range(-5.0, 0.0));
+        for i in 0..3 {
+            f.anchor[k][i] = f.position[k][i] + size * rng.range(-1.0, 1.0);
+            f.lambda_t_bar[k][i] = rng.range(-20.0, 20.0);
+        }
+    }
+    model.evaluate(&u, 1.0, true).unwrap();
+    (model, u)
+}
+
+/// The worst entry of (tangent - central differences) over the largest entry of the tangent,
+/// skipping the columns where a point changes its active or stick/slip state.
+fn fd_error(model: &mut Model<PlateElements>, u: &[f64]) -> (f64, usize) {
+    let states = |m: &Model<PlateElements>| -> Vec<(bool, u8)> {
+        let c = &m.contacts[0];
+        c.state.iter().zip(&c.friction.as_ref().unwrap().status).map(|(s, f)| (s.active, *f)).collect()
+    };
+    let k = dense(model.matrix());
+    let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let neq = model.num_equations();
+    let step = 1e-7;
+    let mut worst = 0.0f64;
+    let mut skipped = 0;
+    for j in 0..neq {
+        let mut du = vec![0.0; neq];
+        du[j] = step;
+        let mut up = u.to_vec();
+        model.add_increment(&mut up, &du);
+        du[j] = -step;
+        let mut um = u.to_vec();
+        model.add_increment(&mut um, &du);
+        model.evaluate(&up, 1.0, false).unwrap();
+        let rp = model.residual().to_vec();
+        let sp = states(model);
+        model.evaluate(&um, 1.0, false).unwrap();
+        if sp != states(model) {
+            skipped += 1;
+            continue;
+        }
+        let rm = model.residual();
+        for i in 0..neq {
+            let fd = (rp[i] - rm[i]) / (2.0 * step);
+            worst = worst.max((fd - k[i][j]).abs() / scale);
+        }
+    }
+    (worst, skipped)
+}
+
+fn check(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>) -> f64 {
+    let (mut model, u) = model_at(surface, seed, 0.3, drive);
+    let f = model.contacts[0].friction.as_ref().unwrap();
+    let stick = f.status.iter().filter(|&&s| s == STICK).count();
+    let slip = f.status.iter().filter(|&&s| s == SLIP).count();
+    assert!(stick >= 2 && slip >= 2, "the state should have points in stick and in slip: {stick} stick, {slip} slip");
+    // the friction's tangent is not symmetric
+    let k = dense(model.matrix());
+    let asym = (0..k.len()).flat_map(|i| (0..k.len()).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max((k[i][j] - k[j][i]).abs()));
+    assert!(asym > 0.0);
+    let (worst, skipped) = fd_error(&mut model, &u);
+    println!("seed {seed}: {stick} stick, {slip} slip, tangent vs differences {worst:e} ({skipped} columns skipped)");
+    assert!(skipped < k.len() / 4, "{skipped} columns crossed a kink");
+    assert!(worst < 1e-6, "model tangent with friction differs from finite differences by {worst:e}");
+    worst
+}
+
+#[test]
+fn friction_tangent_with_a_sphere_matches_finite_differences() {
+    let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    check(Arc::new(s), 11, None);
+}
+
+#[test]
+fn friction_tangent_with_a_force_driven_punch_matches_finite_differences() {
+    let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    check(Arc::new(s), 21, Some([0.3, -0.2, -1.0]));
+    let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
+    check(Arc::new(c), 22, Some([0.0, 0.0, -1.0]));
+}
+
+/// mu = 0 is no friction at all: the same residual and tangent, to the bit, as a pair without
+/// the call.
+#[test]
+fn zero_friction_changes_nothing() {
+    let s = || Arc::new(Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap());
+    let (a, _) = model_at(s(), 11, 0.3, None);
+    assert!(a.contacts[0].friction.is_some());
+    let mut pair = ContactPair::new("p", s(), Vec::new(), 1.0, ContactKinematics::Exact);
+    pair.set_friction(0.0).unwrap();
+    assert!(pair.friction.is_none());
+    assert!(pair.set_friction(-0.1).is_err() && pair.set_friction(f64::NAN).is_err());
+}
