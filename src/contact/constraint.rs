@@ -412,7 +412,8 @@ impl ContactPair {
             .sum::<f64>()
     }
 
-    /// Total force of the punch on the body, sum of -w lambda grad Psi.
+    /// Total force of the punch on the body, sum of -w lambda grad Psi, and with friction the sum
+    /// of the tangential forces -w t.
     pub fn reaction(&self) -> [f64; 3] {
         let mut r = [0.0; 3];
         for (p, s) in self.points.iter().zip(&self.state) {
@@ -420,7 +421,37 @@ impl ContactPair {
                 r[i] -= p.weight * s.lambda * s.grad[i];
             }
         }
+        if let Some(f) = &self.friction {
+            for (p, t) in self.points.iter().zip(&f.traction) {
+                for i in 0..3 {
+                    r[i] -= p.weight * t[i];
+                }
+            }
+        }
         r
+    }
+
+    /// The friction force of the body on the punch, sum of w t (zero without friction).
+    pub fn friction_force(&self) -> [f64; 3] {
+        let mut r = [0.0; 3];
+        if let Some(f) = &self.friction {
+            for (p, t) in self.points.iter().zip(&f.traction) {
+                for i in 0..3 {
+                    r[i] += p.weight * t[i];
+                }
+            }
+        }
+        r
+    }
+
+    /// The energy friction dissipated over the converged steps (None without friction).
+    pub fn friction_dissipation(&self) -> Option<f64> {
+        self.friction.as_ref().map(|f| f.dissipation.iter().sum())
+    }
+
+    /// The numbers of sticking and slipping points at the last evaluation (None without friction).
+    pub fn stick_slip_counts(&self) -> Option<(usize, usize)> {
+        self.friction.as_ref().map(|f| (f.status.iter().filter(|&&s| s == super::STICK).count(), f.status.iter().filter(|&&s| s == super::SLIP).count()))
     }
 
     /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point. With the
