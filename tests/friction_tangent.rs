@@ -161,3 +161,66 @@ fn zero_friction_changes_nothing() {
     assert!(pair.friction.is_none());
     assert!(pair.set_friction(-0.1).is_err() && pair.set_friction(f64::NAN).is_err());
 }
+
+/// A rigid translation of plate and punch together moves no point against the punch: no
+/// friction force, no slip, no dissipation; the same translation of the punch alone drags.
+#[test]
+fn a_rigid_translation_of_plate_and_punch_gives_no_friction() {
+    let mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 4, 4).unwrap();
+    let section = steel_section(0.2);
+    let dp = section.delta_plus;
+    let plate = PlateElements::new(&mesh, section, Kinematics::Nonlinear).unwrap();
+    let dofs = DofMap::new(mesh.num_nodes(), 6).unwrap();
+    let mut model = Model::new(plate, dofs).unwrap();
+    let areas = mesh.nodal_areas();
+    let points = (0..mesh.num_nodes())
+        .map(|n| ContactPoint { node: n, x_ref: [mesh.coords[n][0], mesh.coords[n][1], dp], dofs: [0, 1, 2].map(|c| Face::Top.dof(n, c)), weight: areas[n] })
+        .collect();
+    let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    let mut pair = ContactPair::new("punch", Arc::new(s), points, 3.0e3, ContactKinematics::Exact);
+    pair.entry_fraction = 0.0;
+    let d0 = [0.0, 0.0, -0.05];
+    pair.motion = d0.into();
+    pair.set_friction(0.3).unwrap();
+    model.add_contact(pair);
+    let u0 = vec![0.0; model.num_dofs()];
+    model.evaluate(&u0, 1.0, true).unwrap();
+    // the points touched where they stand: their anchors there, no traction
+    let f = model.contacts[0].friction.as_mut().unwrap();
+    f.anchor.clone_from(&f.position);
+    model.evaluate(&u0, 1.0, true).unwrap();
+    let active = model.contacts[0].state.iter().filter(|s| s.active).count();
+    assert!(active >= 3, "{active} points in contact");
+    model.checkpoint();
+    let normal = model.contacts[0].reaction()[2].abs();
+    let c = [0.3, -0.2, 0.1];
+    let translated = |model: &mut Model<PlateElements>, plate_too: bool| {
+        model.contacts[0].motion = [d0[0] + c[0], d0[1] + c[1], d0[2] + c[2]].into();
+        let mut u1 = u0.clone();
+        if plate_too {
+            for n in 0..mesh.num_nodes() {
+                for i in 0..3 {
+                    u1[Face::Top.dof(n, i)] = c[i];
+                    u1[Face::Bottom.dof(n, i)] = c[i];
+                }
+            }
+        }
+        model.evaluate(&u1, 1.0, true).unwrap();
+        model.contacts[0].friction_force()
+    };
+    let drag = translated(&mut model, true);
+    let fr = model.contacts[0].friction.as_ref().unwrap();
+    assert_eq!(fr.status.iter().filter(|&&s| s == STICK).count(), active, "every point in contact sticks");
+    let largest = fr.traction.iter().map(|t| nalgebra::Vector3::from(*t).norm()).fold(0.0, f64::max);
+    assert!(largest < 1e-9 * normal, "traction {largest:e} after a rigid translation (normal force {normal:e})");
+    assert!(drag.iter().all(|x| x.abs() < 1e-9 * normal), "friction force {drag:?}");
+    model.checkpoint();
+    let fr = model.contacts[0].friction.as_ref().unwrap();
+    assert!(fr.slip.iter().all(|&s| s == 0.0) && fr.dissipation.iter().all(|&d| d == 0.0));
+    // the punch alone moved: it drags the plate, every touching point slides
+    let drag = translated(&mut model, false);
+    let fr = model.contacts[0].friction.as_ref().unwrap();
+    assert!(fr.status.iter().filter(|&&s| s == SLIP).count() >= 3);
+    // (the force of the plate on the punch, against its motion)
+    assert!(drag[0] < -1e-3 * normal && drag[1] > 1e-3 * normal, "drag {drag:?} against the normal force {normal:e}");
+}
