@@ -135,3 +135,54 @@ fn bad_friction_is_refused_with_the_key() {
         println!("{mu} {extra}: {}", err.lines().next().unwrap_or(""));
     }
 }
+
+/// A sphere pressed into the centre of a clamped plate, then moved along x1 by 1e-4, far below
+/// the sliding limit: the centre node sticks to the punch (its slip in pressing is zero by
+/// symmetry), so its top face moves by exactly 1e-4. With `penetration_tolerance` the
+/// augmented-Lagrangian updates make the stick exact to that tolerance; without, the penalty
+/// leaves an elastic creep t / eps_T (3e-7 here).
+#[test]
+fn a_sticking_point_follows_the_punch_exactly_with_augmented_updates() {
+    let text = |tolerance: &str| {
+        format!(
+            r#"title = "a sphere pressed into a clamped plate, then moved along x1 below the stick limit"
+[mesh]
+rectangle = {{ x = [-10.0, 10.0], y = [-10.0, 10.0], n = [20, 20] }}
+[plate]
+thickness = 1.0
+E = 2.1e5
+nu = 0.3
+[[boundary]]
+group = "boundary"
+fix = ["clamped"]
+[[punch]]
+name = "ball"
+shape = "sphere"
+center = [0.0, 0.0, 50.5]
+radius = 50.0
+motion = [[0.5, 0.0, 0.0, -0.2], [1.0, 0.0001, 0.0, -0.2]]
+friction = 1.0
+{tolerance}
+[solver]
+max_increment = 0.25
+"#
+        )
+    };
+    let centre_u1 = |out: &Path| {
+        let last = std::fs::read_dir(out).unwrap().map(|e| e.unwrap().path()).filter(|p| p.file_name().unwrap().to_str().unwrap().starts_with("pressure_ball_")).max().unwrap();
+        let text = std::fs::read_to_string(last).unwrap();
+        // node, x1, x2, x1_deformed, ...: the centre node (0, 0)
+        let row: Vec<f64> = text.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect::<Vec<f64>>()).find(|r| r[1] == 0.0 && r[2] == 0.0).unwrap();
+        row[3] - row[1]
+    };
+    let exact = run("friction-stick-al", &text("penetration_tolerance = 1e-9"));
+    let s = summary(&exact);
+    let last = s["steps"].as_array().unwrap().last().unwrap()["punches"]["ball"].clone();
+    assert!(last["sticking_nodes"].as_u64().unwrap() >= 1, "{last}");
+    let e_al = (centre_u1(&exact) - 1e-4).abs();
+    let penalty = run("friction-stick-penalty", &text(""));
+    let e_pen = (centre_u1(&penalty) - 1e-4).abs();
+    println!("centre node's u1 - punch's travel: {e_al:e} with the updates, {e_pen:e} without");
+    assert!(e_al < 1e-9, "the sticking centre is {e_al:e} off the punch with the updates");
+    assert!(e_pen > 1e-8, "the penalty's creep should show: {e_pen:e}");
+}
