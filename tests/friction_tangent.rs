@@ -224,3 +224,27 @@ fn a_rigid_translation_of_plate_and_punch_gives_no_friction() {
     // (the force of the plate on the punch, against its motion)
     assert!(drag[0] < -1e-3 * normal && drag[1] > 1e-3 * normal, "drag {drag:?} against the normal force {normal:e}");
 }
+
+/// A cut-back restarts from the last converged friction state: `restore` brings back the
+/// anchors, multipliers, slips and dissipations `checkpoint` saved, whatever the failed attempt
+/// did to them.
+#[test]
+fn restore_brings_back_the_friction_state_of_the_checkpoint() {
+    let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    let (mut model, u) = model_at(Arc::new(s), 11, 0.3, None);
+    model.checkpoint();
+    let saved = model.contacts[0].friction.clone().unwrap();
+    // an attempt: another state, a multiplier update, a converged-looking commit
+    let mut v = u.clone();
+    for x in v.iter_mut() {
+        *x *= 1.01;
+    }
+    model.evaluate(&v, 1.0, true).unwrap();
+    model.contacts[0].augment();
+    model.contacts[0].commit_friction();
+    let changed = model.contacts[0].friction.as_ref().unwrap();
+    assert!(changed.anchor != saved.anchor && changed.lambda_t_bar != saved.lambda_t_bar && changed.slip != saved.slip);
+    model.restore();
+    let back = model.contacts[0].friction.as_ref().unwrap();
+    assert_eq!((&back.anchor, &back.lambda_t_bar, &back.slip, &back.dissipation, &back.status), (&saved.anchor, &saved.lambda_t_bar, &saved.slip, &saved.dissipation, &saved.status));
+}
