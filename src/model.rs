@@ -29,6 +29,10 @@ pub struct ModelTimings {
     pub assemblies: usize,
 }
 
+/// What a checkpoint keeps of a contact pair: lambda_bar, the point states, the active flags of
+/// the last evaluation with a tangent, and the friction state.
+type SavedContact = (Vec<f64>, Vec<PointState>, Vec<bool>, Option<crate::contact::Friction>);
+
 /// Elements + dofs + loads + contact: everything that defines R(u, t).
 pub struct Model<E: Element> {
     pub element: E,
@@ -65,7 +69,7 @@ pub struct Model<E: Element> {
     preconditioner: Vec<f64>,
     residual: Vec<f64>,
     energy: f64,
-    saved: Vec<(Vec<f64>, Vec<PointState>, Vec<bool>, Option<crate::contact::Friction>)>,
+    saved: Vec<SavedContact>,
     /// Force scale of the last evaluation, and the largest over the converged steps so far.
     last_scale: f64,
     peak_scale: f64,

@@ -279,9 +279,9 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
                 slip[pt.node] = f.slip[k];
                 state[pt.node] = f64::from(f.status[k]);
             }
-            friction_fields.push(Field::new(&format!("{}_traction", info.name), 3, traction));
-            friction_fields.push(Field::scalar(&format!("{}_slip", info.name), slip));
-            friction_fields.push(Field::scalar(&format!("{}_state", info.name), state));
+            friction_fields.push(Field::new(format!("{}_traction", info.name), 3, traction));
+            friction_fields.push(Field::scalar(format!("{}_slip", info.name), slip));
+            friction_fields.push(Field::scalar(format!("{}_state", info.name), state));
         }
         let q = pair.pressures();
         let lam_max = pair.state.iter().map(|s| s.lambda.abs()).fold(0.0, f64::max);
