@@ -248,3 +248,36 @@ fn restore_brings_back_the_friction_state_of_the_checkpoint() {
     let back = model.contacts[0].friction.as_ref().unwrap();
     assert_eq!((&back.anchor, &back.lambda_t_bar, &back.slip, &back.dissipation, &back.status), (&saved.anchor, &saved.lambda_t_bar, &saved.slip, &saved.dissipation, &saved.status));
 }
+
+/// GMRES on the LDL^T of the plate's symmetric preconditioner P, which holds a symmetric stand-in
+/// of the friction's tangent, solves the unsymmetric system with points in stick and in slip:
+/// the sparse LU's solution, in a few iterations, and not by falling back to the LU.
+#[test]
+fn gmres_on_the_symmetric_preconditioner_solves_the_friction_tangent() {
+    use stamp::linalg::linear_solver::LinearSolver;
+    let s = Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap();
+    let (mut model, u) = model_at(Arc::new(s), 11, 0.3, None);
+    model.want_preconditioner(true);
+    model.evaluate(&u, 1.0, true).unwrap();
+    let r = model.residual().to_vec();
+    let mut x_lu = r.clone();
+    let mut lu = stamp::linalg::linear_solver::SparseLu::new();
+    lu.factorize(model.matrix()).unwrap();
+    lu.solve_in_place(&mut x_lu).unwrap();
+    let p = model.preconditioner().expect("the plate gives P");
+    let pd = p.to_dense();
+    let n = pd.nrows();
+    let asym = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max((pd[(i, j)] - pd[(j, i)]).abs()));
+    assert!(asym == 0.0 || asym < 1e-12 * pd.norm_max(), "P is not symmetric: {asym:e}");
+    let mut g = stamp::linalg::ldlt_gmres::LdltGmres::new().with_preconditioner(true);
+    g.factorize_preconditioned(model.matrix(), Some(p)).unwrap();
+    let mut x = r.clone();
+    g.solve_in_place(&mut x).unwrap();
+    let norm = x_lu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = x_lu.iter().zip(&x).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let st = g.stats();
+    println!("GMRES on LDL^T(P): {} iterations, {} preconditioned, {} LU fallbacks; differs from LU by {:e}", st.gmres_iterations, st.preconditioned, st.lu_fallbacks, diff / norm);
+    assert!(diff < 1e-8 * norm, "GMRES with P differs from the LU by {diff:e} (|x| = {norm:e})");
+    assert_eq!(st.lu_fallbacks, 0);
+    assert!(st.preconditioned == 1 && st.gmres_iterations <= 30, "{st:?}");
+}
