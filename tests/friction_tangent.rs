@@ -149,8 +149,8 @@ fn friction_tangent_with_a_force_driven_punch_matches_finite_differences() {
     check(Arc::new(c), 22, Some([0.0, 0.0, -1.0]));
 }
 
-/// mu = 0 is no friction at all: the same residual and tangent, to the bit, as a pair without
-/// the call.
+/// mu = 0 is no friction at all: no friction state (so no friction code runs; the bitwise
+/// comparison of whole runs is in docs/design.md, "Friction"); bad coefficients are refused.
 #[test]
 fn zero_friction_changes_nothing() {
     let s = || Arc::new(Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap());

@@ -31,7 +31,8 @@
 //! its gradient at a point; `normal_law.rs` the frictionless law of one point (its multiplier and
 //! its tangent); `evaluate.rs` one evaluation of every point; `nodal.rs` the paper's collocation
 //! at the nodes; `integrated.rs` the integrated discretisation on a [`ContactFace`];
-//! `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
+//! `friction_law.rs` Coulomb friction of a nodal point (its return map, its tangent, its history;
+//! docs/design.md, "Friction"); `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
 //! `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves; `share.rs` the points
 //! of one process.
 
