@@ -29,6 +29,10 @@ pub struct ModelTimings {
     pub assemblies: usize,
 }
 
+/// What a checkpoint keeps of a contact pair: lambda_bar, the point states, the active flags of
+/// the last evaluation with a tangent, and the friction state.
+type SavedContact = (Vec<f64>, Vec<PointState>, Vec<bool>, Option<crate::contact::Friction>);
+
 /// Elements + dofs + loads + contact: everything that defines R(u, t).
 pub struct Model<E: Element> {
     pub element: E,
@@ -65,7 +69,7 @@ pub struct Model<E: Element> {
     preconditioner: Vec<f64>,
     residual: Vec<f64>,
     energy: f64,
-    saved: Vec<(Vec<f64>, Vec<PointState>, Vec<bool>)>,
+    saved: Vec<SavedContact>,
     /// Force scale of the last evaluation, and the largest over the converged steps so far.
     last_scale: f64,
     peak_scale: f64,
@@ -294,6 +298,11 @@ impl<E: Element> Model<E> {
     /// entries: those of its own elements and the whole rows of its own nodes (every element
     /// around them), the rows and columns of the force-driven punches whole.
     pub fn set_share(&mut self, share: Option<Share>) -> Result<()> {
+        if share.is_some() {
+            if let Some(c) = self.contacts.iter().find(|c| c.friction.is_some()) {
+                return Err(StampError::Problem(format!("punch '{}': friction is not implemented in a distributed run (its state is not shared between the processes)", c.name)));
+            }
+        }
         let (ne, nn) = (self.element.num_elements(), self.dofs.num_nodes());
         self.assembler = match &share {
             Some(s) => {
@@ -482,22 +491,41 @@ impl<E: Element> NonlinearProblem for Model<E> {
             let force = if shared { &mut self.contact_force } else { &mut self.force };
             let eq = |d: usize| equation_of(dofs, d);
             let mine = owns_row(&self.share, dofs.dofs_per_node(), nd);
-            // the contact stiffness is symmetric: it belongs to the preconditioner as it is
-            let mut add = |r: usize, c: usize, v: f64| {
-                if !mine(r, c) {
-                    return;
+            for pair in self.contacts.iter_mut() {
+                {
+                    // the contact stiffness is symmetric: it belongs to the preconditioner as it is
+                    let mut add = |r: usize, c: usize, v: f64| {
+                        if !mine(r, c) {
+                            return;
+                        }
+                        if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
+                            if let Some(s) = pattern.find(re, ce) {
+                                values[s] += v;
+                                if let Some(p) = preconditioner.get_mut(s) {
+                                    *p += v;
+                                }
+                            }
+                        }
+                    };
+                    changes += if with_tangent { pair.evaluate(u, t, force, Some(&mut add))? } else { pair.evaluate(u, t, force, None)? };
                 }
-                if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
-                    if let Some(s) = pattern.find(re, ce) {
-                        values[s] += v;
-                        if let Some(p) = preconditioner.get_mut(s) {
-                            *p += v;
+                if with_tangent {
+                    // friction's tangent is not symmetric: the preconditioner gets a symmetric
+                    // stand-in (see stamp::contact::PointFriction)
+                    for &(r, c, v, pv) in pair.friction_entries() {
+                        if !mine(r, c) {
+                            continue;
+                        }
+                        if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
+                            if let Some(s) = pattern.find(re, ce) {
+                                values[s] += v;
+                                if let Some(p) = preconditioner.get_mut(s) {
+                                    *p += pv;
+                                }
+                            }
                         }
                     }
                 }
-            };
-            for pair in self.contacts.iter_mut() {
-                changes += if with_tangent { pair.evaluate(u, t, force, Some(&mut add))? } else { pair.evaluate(u, t, force, None)? };
                 // an integrated punch whose contact reached points the pattern does not couple:
                 // couple them from the next evaluation on (this tangent lacks those entries)
                 if pair.needs_coupling() {
@@ -678,13 +706,18 @@ impl<E: Element> NonlinearProblem for Model<E> {
                 self.pending.get_or_insert(e);
             }
         }
-        self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone(), c.last_active.clone())).collect();
+        // friction: the slipping points' anchors follow their slip
+        for c in self.contacts.iter_mut() {
+            c.commit_friction();
+        }
+        self.saved = self.contacts.iter().map(|c| (c.lambda_bar.clone(), c.state.clone(), c.last_active.clone(), c.friction.clone())).collect();
     }
     fn restore(&mut self) {
-        for (c, (lb, st, la)) in self.contacts.iter_mut().zip(&self.saved) {
+        for (c, (lb, st, la, fr)) in self.contacts.iter_mut().zip(&self.saved) {
             c.lambda_bar.clone_from(lb);
             c.state.clone_from(st);
             c.last_active.clone_from(la);
+            c.friction.clone_from(fr);
         }
     }
 }

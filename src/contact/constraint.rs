@@ -5,6 +5,7 @@
 
 use super::first_touch::{ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 use super::kinematics::{Kinematics, SurfaceAtPoint};
+use super::friction_law::Friction;
 use super::{ContactFace, ForceDrive, PointShare, PunchMotion};
 use crate::surface::ContactSurface;
 use nalgebra::Vector3;
@@ -186,6 +187,8 @@ pub struct ContactPair {
     pub(super) last_trial: Vec<f64>,
     /// The points this process evaluates in a distributed run (see [`PointShare`]); None: all.
     pub(super) share: Option<PointShare>,
+    /// Coulomb friction ([`set_friction`](Self::set_friction)); None: frictionless.
+    pub friction: Option<Friction>,
 }
 
 impl ContactPair {
@@ -235,7 +238,31 @@ impl ContactPair {
             converged_scale: 0.0,
             last_trial: vec![0.0; n],
             share: None,
+            friction: None,
         }
+    }
+
+    /// Coulomb friction of coefficient `mu` between the body and this punch (docs/design.md,
+    /// "Friction"); 0: none (frictionless, the same operations as without this call). Nodal
+    /// contact with exact kinematics only, set after eps_reg (the tangential regularisation is
+    /// eps_reg |grad Psi|^2 where the punch touches).
+    pub fn set_friction(&mut self, mu: f64) -> crate::Result<()> {
+        if !(mu.is_finite() && mu >= 0.0) {
+            return Err(crate::StampError::Problem(format!("the friction coefficient must be a finite number >= 0, got {mu}")));
+        }
+        if mu == 0.0 {
+            self.friction = None;
+            return Ok(());
+        }
+        if self.face.is_some() {
+            return Err(crate::StampError::Problem("friction is implemented for the nodal contact scheme only, not the integrated one".into()));
+        }
+        if self.kinematics != ContactKinematics::Exact {
+            return Err(crate::StampError::Problem("friction needs the exact contact kinematics, not the shallow constraint".into()));
+        }
+        let g = self.contact_gradient_norm();
+        self.friction = Some(Friction::new(mu, self.eps_reg * g * g, self.points.iter().map(|p| p.x_ref)));
+        Ok(())
     }
 
     /// Evaluate only the points of `own` nodes from now on (`own[n]`: this process owns node n),
@@ -312,6 +339,14 @@ impl ContactPair {
                 self.lambda_bar[k] = self.state[k].lambda;
             }
         }
+        if self.friction.is_some() {
+            let share = self.share.take();
+            let evaluated = |k: usize| share.as_ref().is_none_or(|s| s.evaluated[k]);
+            if let Some(f) = &mut self.friction {
+                f.augment(evaluated);
+            }
+            self.share = share;
+        }
     }
 
     /// How far the augmented-Lagrangian multipliers are from converged, as a length: the largest
@@ -332,7 +367,11 @@ impl ContactPair {
                 if g > 0.0 { s.psi.abs() / g } else { 0.0 }
             })
             .fold(0.0, f64::max);
-        gaps.max(self.penetration_where(|k| self.owns(k)))
+        let violation = gaps.max(self.penetration_where(|k| self.owns(k)));
+        match &self.friction {
+            None => violation,
+            Some(f) => violation.max(f.stick_violation(|k| Vector3::from(self.state[k].grad).normalize(), |k| self.owns(k))),
+        }
     }
 
     /// The largest penetration max(0, -Psi) over the points, in units of Psi divided by
@@ -373,7 +412,8 @@ impl ContactPair {
             .sum::<f64>()
     }
 
-    /// Total force of the punch on the body, sum of -w lambda grad Psi.
+    /// Total force of the punch on the body, sum of -w lambda grad Psi, and with friction the sum
+    /// of the tangential forces -w t.
     pub fn reaction(&self) -> [f64; 3] {
         let mut r = [0.0; 3];
         for (p, s) in self.points.iter().zip(&self.state) {
@@ -381,7 +421,37 @@ impl ContactPair {
                 r[i] -= p.weight * s.lambda * s.grad[i];
             }
         }
+        if let Some(f) = &self.friction {
+            for (p, t) in self.points.iter().zip(&f.traction) {
+                for i in 0..3 {
+                    r[i] -= p.weight * t[i];
+                }
+            }
+        }
         r
+    }
+
+    /// The friction force of the body on the punch, sum of w t (zero without friction).
+    pub fn friction_force(&self) -> [f64; 3] {
+        let mut r = [0.0; 3];
+        if let Some(f) = &self.friction {
+            for (p, t) in self.points.iter().zip(&f.traction) {
+                for i in 0..3 {
+                    r[i] += p.weight * t[i];
+                }
+            }
+        }
+        r
+    }
+
+    /// The energy friction dissipated over the converged steps (None without friction).
+    pub fn friction_dissipation(&self) -> Option<f64> {
+        self.friction.as_ref().map(|f| f.dissipation.iter().sum())
+    }
+
+    /// The numbers of sticking and slipping points at the last evaluation (None without friction).
+    pub fn stick_slip_counts(&self) -> Option<(usize, usize)> {
+        self.friction.as_ref().map(|f| (f.status.iter().filter(|&&s| s == super::STICK).count(), f.status.iter().filter(|&&s| s == super::SLIP).count()))
     }
 
     /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point. With the

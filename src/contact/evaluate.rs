@@ -66,6 +66,9 @@ impl ContactPair {
         // for STAMP_DEBUG: points deferred, released, entering, penetrating, held
         let mut tally = [0usize; 5];
         let integrated = self.face.is_some();
+        if let (Some(f), true) = (&mut self.friction, with_tangent) {
+            f.entries.clear();
+        }
         if integrated {
             self.tangent_points.clear();
             self.tangent_points.resize(self.points.len(), false);
@@ -92,6 +95,9 @@ impl ContactPair {
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
             // a point that cycled keeps the active-side tangent near the kink (its force stays exact)
             let near_kink = !self.hold_active_set && self.frozen[k] && with_tangent && trial <= rules.band;
+            if self.friction.is_some() {
+                self.add_friction(k, lambda, active, &grad, hess.as_ref(), &dn, force, with_tangent);
+            }
             if !active && !near_kink {
                 continue;
             }

@@ -31,8 +31,9 @@
 //! its gradient at a point; `normal_law.rs` the frictionless law of one point (its multiplier and
 //! its tangent); `evaluate.rs` one evaluation of every point; `nodal.rs` the paper's collocation
 //! at the nodes; `integrated.rs` the integrated discretisation on a [`ContactFace`];
-//! `recover.rs` the recovered pressure field
-//! written beside the nodal one; `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
+//! `recover.rs` the recovered pressure field written beside the nodal one; `friction_law.rs`
+//! Coulomb friction of a nodal point (its return map, its tangent, its history; docs/design.md,
+//! "Friction"); `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
 //! `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves; `share.rs` the points
 //! of one process.
 
@@ -40,6 +41,7 @@ mod constraint;
 mod evaluate;
 mod face;
 mod first_touch;
+mod friction_law;
 mod integrated;
 mod kinematics;
 mod motion;
@@ -50,6 +52,7 @@ mod regularisation;
 mod share;
 pub use constraint::{ContactKinematics, ContactPair, ContactPoint, PointState};
 pub use face::ContactFace;
+pub use friction_law::{return_map, Friction, PointFriction, OPEN, SLIP, STICK};
 pub use first_touch::{CONVERGING_TENSION, DEEP_ENTRY_RATIO, ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 pub use motion::{ForceDrive, PunchMotion};
 pub use recover::{recovered_pressure, RecoveredPressure, Recovery, RECOVERY};

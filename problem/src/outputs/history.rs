@@ -28,6 +28,10 @@ pub struct PunchRow {
     pub contact_area: f64,
     pub max_pressure: f64,
     pub max_penetration: f64,
+    /// The force of the plate on the punch in global axes (normal and friction forces).
+    pub force_on_punch: [f64; 3],
+    /// The energy friction dissipated so far (None: a punch without friction).
+    pub dissipation: Option<f64>,
 }
 
 /// One converged step.
@@ -73,6 +77,8 @@ pub fn punch_row(pair: &ContactPair, face: Face, u: &[f64], t: f64) -> PunchRow 
     PunchRow {
         travel,
         force: dot(pair.reaction(), d),
+        force_on_punch: pair.reaction().map(|x| -x),
+        dissipation: pair.friction_dissipation(),
         contact_area,
         max_pressure: q.iter().cloned().fold(0.0, f64::max),
         max_penetration: pair.max_penetration(),
@@ -148,6 +154,15 @@ impl History {
         for (n, _) in &self.points {
             s.push_str(&format!(",{n}_u1,{n}_u2,{n}_u3"));
         }
+        // after the columns above: the force on each punch in global axes, and the friction's
+        // dissipation of the punches with friction
+        let friction: Vec<bool> = (0..self.punch_names.len()).map(|k| self.rows.first().is_some_and(|r| r.punches[k].dissipation.is_some())).collect();
+        for (k, n) in self.punch_names.iter().enumerate() {
+            s.push_str(&format!(",{n}_force_x1,{n}_force_x2,{n}_force_x3"));
+            if friction[k] {
+                s.push_str(&format!(",{n}_dissipation"));
+            }
+        }
         s.push('\n');
         for r in &self.rows {
             s.push_str(&format!("{},{:e},{:e}", r.step, r.load_factor, r.path));
@@ -156,6 +171,13 @@ impl History {
             }
             for v in &r.points {
                 s.push_str(&format!(",{:e},{:e},{:e}", v[0], v[1], v[2]));
+            }
+            for p in &r.punches {
+                let f = p.force_on_punch;
+                s.push_str(&format!(",{:e},{:e},{:e}", f[0], f[1], f[2]));
+                if let Some(d) = p.dissipation {
+                    s.push_str(&format!(",{d:e}"));
+                }
             }
             s.push('\n');
         }
@@ -260,7 +282,7 @@ mod tests {
     fn plot_title(name: &str, steps: &[(f64, f64)]) -> String {
         let mut h = History::new(&[(name.into(), Face::Top, false)], &[]);
         for (k, &(t, travel)) in steps.iter().enumerate() {
-            let punches = vec![PunchRow { travel, force: 10.0 * t, contact_area: 1.0, max_pressure: 1.0, max_penetration: 0.0 }];
+            let punches = vec![PunchRow { travel, force: 10.0 * t, contact_area: 1.0, max_pressure: 1.0, max_penetration: 0.0, force_on_punch: [0.0; 3], dissipation: None }];
             h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0 });
         }
         let dir = std::env::temp_dir().join(format!("stamp-history-plot-{}-{name}", std::process::id()));

@@ -87,6 +87,11 @@ pub struct PunchOut {
     /// them has all its cells' nodes loaded (a line or a ring of nodes): the peak pressure then
     /// depends on the mesh (see [`narrower_than_cells`]).
     pub zone_narrower_than_cells: bool,
+    /// With friction: the candidate points sticking and slipping (absent without friction).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sticking_nodes: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slipping_nodes: Option<usize>,
 }
 
 /// Whether the loaded nodes (`loaded[node]`) form a zone narrower than the cells: at least three
@@ -268,7 +273,20 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
     let mut punches = BTreeMap::new();
     let mut loaded_pts = Vec::new();
     let mut punch_rows = Vec::new();
+    // the friction's arrays of the punches with friction
+    let mut friction_fields = Vec::new();
     for (info, pair) in cx.punches.iter().zip(&model.contacts) {
+        if let Some(f) = &pair.friction {
+            let (mut traction, mut slip, mut state) = (vec![0.0; 3 * n], vec![0.0; n], vec![0.0; n]);
+            for (k, pt) in pair.points.iter().enumerate() {
+                traction[3 * pt.node..3 * pt.node + 3].copy_from_slice(&f.traction[k]);
+                slip[pt.node] = f.slip[k];
+                state[pt.node] = f64::from(f.status[k]);
+            }
+            friction_fields.push(Field::new(format!("{}_traction", info.name), 3, traction));
+            friction_fields.push(Field::scalar(format!("{}_slip", info.name), slip));
+            friction_fields.push(Field::scalar(format!("{}_state", info.name), state));
+        }
         let q = pair.pressures();
         let p_rec = stamp::contact::recovered_pressure(pair, &cx.mesh.mesh.cells, stamp::contact::RECOVERY).pressure;
         for (pt, v) in pair.points.iter().zip(&p_rec) {
@@ -341,6 +359,8 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
                 max_pressure: q.iter().cloned().fold(0.0, f64::max),
                 eps_reg: pair.eps_reg,
                 zone_narrower_than_cells: narrower_than_cells(&cx.mesh.mesh.cells, &loaded_here),
+                sticking_nodes: pair.stick_slip_counts().map(|c| c.0),
+                slipping_nodes: pair.stick_slip_counts().map(|c| c.1),
             },
         );
         loaded_pts.extend(p_loaded);
@@ -360,6 +380,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
     }
     point_fields.push(Field::scalar("active", active.clone()));
     point_fields.push(Field::scalar("loaded", loaded.clone()));
+    point_fields.extend(friction_fields);
     let points = cx
         .point_groups
         .iter()

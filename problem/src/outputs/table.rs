@@ -90,7 +90,7 @@ mod tests {
                 load_factor: *t,
                 path: *t,
                 newton_iterations: 4 + k,
-                punches: vec![PunchRow { travel: 0.5 * t, force: 500.0 * t, contact_area: 3.0, max_pressure: 12.5, max_penetration: 1e-7 }],
+                punches: vec![PunchRow { travel: 0.5 * t, force: 500.0 * t, contact_area: 3.0, max_pressure: 12.5, max_penetration: 1e-7, force_on_punch: [0.0; 3], dissipation: None }],
                 points: vec![],
                 max_deflection: -0.1 * t,
             });

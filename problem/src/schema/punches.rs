@@ -3,7 +3,7 @@
 
 use super::Problem;
 use super::limits;
-use super::values::{vec_text, Finite, Positive, Vec3};
+use super::values::{vec_text, Finite, FrictionCoefficient, Positive, Vec3};
 use serde::Deserialize;
 use serde::de::{Deserializer, Error as _};
 use stamp::{quote, Result};
@@ -156,6 +156,10 @@ pub struct PunchSpec {
     /// "integrated" (each node's weighted gap over its cells); default: see model/build.rs.
     #[serde(default)]
     pub contact: Option<ContactSpec>,
+    /// The Coulomb friction coefficient mu between the plate and the punch (default 0:
+    /// frictionless). Nodal contact with exact kinematics only.
+    #[serde(default)]
+    pub friction: Option<Spanned<FrictionCoefficient>>,
 }
 
 /// `[[punch]] contact`: the discretisation of the contact constraint.

@@ -42,6 +42,7 @@ macro_rules! checked_number {
 checked_number!(Positive, "a positive number from 1e-100 to 1e100", |v| (limits::MIN_MAGNITUDE..=limits::MAX_MAGNITUDE).contains(&v));
 checked_number!(NonNegative, "a number from 0 to 1e100", |v| (0.0..=limits::MAX_MAGNITUDE).contains(&v));
 checked_number!(Finite, "a finite number of magnitude at most 1e100", |v| v.abs() <= limits::MAX_MAGNITUDE);
+checked_number!(FrictionCoefficient, "a friction coefficient from 0 to 10", |v| (0.0..=10.0).contains(&v));
 checked_number!(Poisson, "Poisson's ratio in (-1, 0.5)", |v| v > -1.0 && v < 0.5);
 checked_number!(Fraction, "a number in [0, 1)", |v| (0.0..1.0).contains(&v));
 checked_number!(Increment, "a load increment in [1e-12, 1e6]", |v| (limits::MIN_INCREMENT..=limits::MAX_LOAD_FACTOR).contains(&v));
