@@ -360,3 +360,33 @@ fn a_stdout_closed_early_ends_quietly_and_a_full_one_is_an_error() {
     // the run wrote its files all the same, and says so truthfully
     assert_eq!(summary(std::path::Path::new(out))["status"], "converged");
 }
+
+/// `stamp check` makes the checks `stamp run` makes of the outputs before its first step: a
+/// thickness probe off the plate, "equilibrium" where the cells cannot be fitted (a strip one cell wide), a
+/// thickness probe on a plate of two surfaces, a probe line off the plate (each passed `stamp
+/// check` and was refused by `stamp run`).
+#[test]
+fn stamp_check_refuses_the_probes_the_run_refuses() {
+    let probe = |at: &str, extra: &str| format!("\n[[output.thickness_probe]]\nname = \"p\"\nat = {at}\n{extra}");
+    let cases = [
+        ("off", variant("probe-off", "laminate-sphere.toml", &[]), probe("[50.0, 50.0]", ""), "output.thickness_probe[3].at"),
+        (
+            "coarse",
+            variant("probe-coarse", "laminate-sphere.toml", &[("n = [40, 40]", "n = [4, 1]")]),
+            probe("[5.0, 5.0]", "transverse_shear = \"equilibrium\"\n"),
+            "output.thickness_probe[3].transverse_shear",
+        ),
+        ("two-surfaces", variant("probe-two", "sphere-ss.toml", &[]), probe("[5.0, 5.0]", ""), "output.thickness_probe[0]"),
+    ];
+    for (name, path, extra, key) in cases {
+        let text = std::fs::read_to_string(&path).unwrap() + &extra;
+        std::fs::write(&path, text).unwrap();
+        let o = check(&path);
+        assert!(!o.ok && o.stderr.contains(key), "{name}: {}", o.stderr);
+    }
+    let line = variant("probe-line-off", "sphere-ss.toml", &[]);
+    let text = std::fs::read_to_string(&line).unwrap() + "\n[[output.probe]]\nname = \"far\"\nfrom = [100.0, 100.0]\nto = [200.0, 100.0]\n";
+    std::fs::write(&line, text).unwrap();
+    let o = check(&line);
+    assert!(!o.ok && o.stderr.contains("output.probe[0]"), "{}", o.stderr);
+}

@@ -59,7 +59,7 @@ impl Orthotropic {
         let m3 = det3(&t);
         if !(m2 > 0.0 && m3 > 0.0) {
             return Err(StampError::Material(format!(
-                "the Poisson ratios nu12, nu13, nu23 = {:?} with E = {:?} give a compliance that is not positive definite (1 - nu12 nu21 = {m2:.4}, 1 - nu12 nu21 - nu23 nu32 - nu13 nu31 - 2 nu21 nu32 nu13 = {m3:.4}): no stable material",
+                "the Poisson ratios nu12, nu13, nu23 = {:?} with E = {:?} give a compliance that is not positive definite (1 - nu12 nu21 = {m2:.4e}, 1 - nu12 nu21 - nu23 nu32 - nu13 nu31 - 2 nu21 nu32 nu13 = {m3:.4e}): no stable material",
                 self.poisson, self.young
             )));
         }

@@ -157,22 +157,22 @@ fn check_supported_nodes_under(p: &Problem, setup: &Setup, i: usize) -> Result<(
     }
     for &t in &samples {
         let d = pair.motion.displacement(t);
-        let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        if norm == 0.0 {
+        if d == [0.0; 3] {
             continue;
         }
-        // the axis the punch travels along most
-        let axis = (0..3).max_by(|&a, &b| d[a].abs().total_cmp(&d[b].abs())).unwrap_or(2);
         for q in &pair.points {
-            let own = dofs.equation(q.dofs[axis]).is_none();
-            let any = own || (0..dpn / 3).any(|s| dofs.equation(q.node * dpn + 3 * s + axis).is_none());
-            if !any {
-                continue;
-            }
             let x = Vector3::from(q.x_ref) - Vector3::from(d);
             let (psi, g) = pair.surface.psi_and_gradient(&x);
             let gn = g.norm();
-            if !(gn > 0.0 && psi.is_finite()) {
+            if !(gn > 0.0 && psi.is_finite() && psi < 0.0) {
+                continue;
+            }
+            // the axis the punch's surface pushes the node along most (its normal there): a
+            // punch dragged along x1 still presses along x3
+            let axis = (0..3).max_by(|&a, &b| g[a].abs().total_cmp(&g[b].abs())).unwrap_or(2);
+            let own = dofs.equation(q.dofs[axis]).is_none();
+            let any = own || (0..dpn / 3).any(|s| dofs.equation(q.node * dpn + 3 * s + axis).is_none());
+            if !any {
                 continue;
             }
             let depth = -psi / gn;
