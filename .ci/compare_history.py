@@ -3,7 +3,8 @@
 value within TOL relative to its column's scale, |a - b| <= TOL * scale, the scale being the
 largest magnitude in the column (both files) and, for the displacement columns (names ending
 _u1, _u2, _u3), the largest displacement of any of them: a displacement that is zero by symmetry
-holds round-off (1e-17) and is judged on the size of the displacements, not on its own noise.
+holds round-off (1e-17) and is judged on the size of the displacements, not on its own noise;
+likewise a punch's force components (_force_x1, _x2, _x3) on the size of its force.
 Prints the worst column; exit 1 on a difference."""
 import csv
 import sys
@@ -45,6 +46,12 @@ def main(ref_path, new_path, tol=TOL):
                 return 1
             continue
         scale = u_scale if c in displacement else max([abs(x) for x in a + b] + [0.0])
+        # a punch's force components (<punch>_force_x1, _x2, _x3): judged on the size of its
+        # force, as displacements are (a frictionless punch's tangential components are round-off)
+        for suffix in ("_force_x1", "_force_x2", "_force_x3"):
+            if name.endswith(suffix):
+                punch = name[: -len(suffix)]
+                scale = max([abs(x) for k, n in enumerate(h1) if n.startswith(punch + "_force") for x in numbers(k)] + [0.0])
         for k, (x, y) in enumerate(zip(a, b)):
             d = abs(x - y) / scale if scale > 0 else 0.0
             if d > worst[0]:
