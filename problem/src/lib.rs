@@ -52,7 +52,7 @@ pub fn run(problem: &Path, out: Option<&Path>, quiet: bool) -> stamp::Result<Run
 
 /// Build, check, solve and write the problem `p` into `out_dir`: the pipeline of `stamp run` and
 /// of the Python package's `Problem.solve` ([`run::solve_and_write`] writes the [`outputs`] of
-/// every step as soon as it converges). The checks of [`checks::check`] come first: an error stops the run before anything is written,
+/// every step as soon as it converges). The checks of [`checks::check()`] come first: an error stops the run before anything is written,
 /// warnings go to stderr (also when quiet), and so do, after the run, the warnings of
 /// [`checks::after_the_run`] (a punch that never touched the plate, a contact zone narrower than
 /// the cells). On a Newton failure the converged steps are written and the error is returned.

@@ -1,5 +1,5 @@
 //! The check report: what is wrong with a built problem, said before the solve (`stamp check`,
-//! and first in `stamp run`) by [`check`], with [`rigid_modes`] (rigid motions held by nothing),
+//! and first in `stamp run`) by [`mod@check`], with [`rigid_modes`] (rigid motions held by nothing),
 //! [`travel_modes`] (force-driven punches' travels held by nothing), [`punch_start`] (gaps at the
 //! start), [`psi_checks`] (a punch's Psi) and [`cell_shape`] (cells of extreme aspect ratio).
 

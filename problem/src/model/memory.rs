@@ -33,7 +33,7 @@ const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 ///   separators' dense blocks are (dofs_per_node)^2 a node pair), but at most dense: N^2 / 2
 ///   numbers;
 /// * the tangent, its preconditioner and their indices: 9 neighbouring nodes a node, a block of
-///   (dofs_per_node)^2 each, [`BLOCK_BYTES`] an entry.
+///   (dofs_per_node)^2 each, `BLOCK_BYTES` (24 bytes) an entry.
 ///
 /// Measured (peak RSS, `stamp run`, 4 x 4 cells, 2026-11-28): 40 plies x 3 surfaces (243 unknowns
 /// a node) 0.43 GB, estimate 0.53 GB; 44 plies (267) 0.54 GB, estimate 0.63 GB; 20 plies (123)
