@@ -203,20 +203,8 @@ fn file(p: &Problem) -> String {
 
 /// Half the diagonal of the plate's bounding box, at least the thickness.
 fn model_size(setup: &Setup) -> f64 {
-    let (lo, hi) = bbox(&setup.mesh);
+    let (lo, hi) = setup.mesh.bounding_box();
     (0.5 * ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2)).sqrt()).max(setup.section.thickness())
-}
-
-fn bbox(mesh: &MeshData) -> ([f64; 2], [f64; 2]) {
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
-    for c in &mesh.mesh.coords {
-        for i in 0..2 {
-            lo[i] = lo[i].min(c[i]);
-            hi[i] = hi[i].max(c[i]);
-        }
-    }
-    (lo, hi)
 }
 
 fn vec3(v: [f64; 3]) -> String {
@@ -379,7 +367,7 @@ fn face_normal(f: Face) -> Vector3<f64> {
 /// Err when the supports and the punches at the start leave a rigid motion free; else a line for
 /// the summary saying what holds them.
 fn check_rigid_modes(p: &Problem, setup: &Setup, starts: &[PunchStart], size: f64) -> Result<String> {
-    let (lo, hi) = bbox(&setup.mesh);
+    let (lo, hi) = setup.mesh.bounding_box();
     let (dm, dp) = (setup.section.delta_minus, setup.section.delta_plus);
     let mut modes = RigidModes::new([0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (dm + dp)], size);
     let coords = &setup.mesh.mesh.coords;

@@ -583,13 +583,7 @@ fn build_punches(p: &Problem, mesh: &MeshData, section: &Section, young: f64, ki
 /// smallest loads are measured against it, so that a problem in other units (E = 1e-20, or a
 /// force of 1e-15 on steel) is judged as the same problem in MPa and mm.
 pub fn stiffness_force(mesh: &MeshData, section: &Section, young: f64) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for x in &mesh.mesh.coords {
-        for d in 0..2 {
-            lo[d] = lo[d].min(x[d]);
-            hi[d] = hi[d].max(x[d]);
-        }
-    }
+    let (lo, hi) = mesh.bounding_box();
     let span = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     young * section.thickness() * span
 }

@@ -33,6 +33,19 @@ pub struct MeshData {
 }
 
 impl MeshData {
+    /// The lowest and highest (x1, x2) of the nodes.
+    pub fn bounding_box(&self) -> ([f64; 2], [f64; 2]) {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for c in &self.mesh.coords {
+            for i in 0..2 {
+                lo[i] = lo[i].min(c[i]);
+                hi[i] = hi[i].max(c[i]);
+            }
+        }
+        (lo, hi)
+    }
+
     /// Load the mesh the problem names.
     pub fn load(p: &Problem) -> Result<MeshData> {
         let spec = p.spec.mesh.get_ref();

@@ -125,51 +125,42 @@ pub fn agreed_interrupt() -> Option<Box<dyn Fn(bool) -> bool>> {
     None
 }
 
+/// A hash of what a rank solves: the problem file's text (or the table a dict was turned into)
+/// and the mesh's coordinates and cells (a gmsh file read beside it). The ranks compare it before
+/// they share the model: ranks whose problem files differ (E on one rank, another punch force)
+/// deadlocked after the first Newton iteration or ignored the difference.
+pub fn inputs_hash(p: &Problem, mesh: &stamp::mesh::QuadMesh) -> u64 {
+    let h = fnv(FNV_START, p.source.bytes());
+    let h = fnv(h, mesh.coords.iter().flat_map(|x| x.iter().flat_map(|v| v.to_bits().to_le_bytes())));
+    fnv(h, mesh.cells.iter().flatten().flat_map(|&n| (n as u64).to_le_bytes()))
+}
+
+/// The FNV-1a hash's starting value.
+const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// `h` with `bytes` folded in (FNV-1a): what the ranks compare.
+fn fnv(h: u64, bytes: impl IntoIterator<Item = u8>) -> u64 {
+    bytes.into_iter().fold(h, |h, b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
+}
+
+/// Every rank's hash `h` the same, or the error `differs` that stops them all (collective).
+#[cfg(feature = "petsc")]
+fn same_on_every_rank(petsc: &stamp_petsc::Petsc, h: u64, differs: impl FnOnce() -> String) -> Result<()> {
+    let (mut hi, mut lo) = ([h], [h]);
+    petsc.max_u64(&mut hi)?;
+    petsc.min_u64(&mut lo)?;
+    if hi != lo {
+        return Err(stamp::StampError::Problem(differs()));
+    }
+    Ok(())
+}
+
 /// On P > 1 ranks, share the model over them (see `stamp::share`): METIS splits the elements
 /// into P parts, each rank evaluates only its own, and each node (its equations, its contact and
 /// follower-load tangent rows) belongs to the rank of the lowest-numbered element around it; the
 /// linear solver is told the same owners, so that each rank's rows of the distributed matrices are
 /// mostly its own elements' entries. On one rank, with fewer elements than ranks, or without the
 /// feature `petsc`: nothing (every rank evaluates the whole model).
-/// A hash of what a rank solves: the problem file's text (or the table a dict was turned into)
-/// and the mesh's coordinates and cells (a gmsh file read beside it). The ranks compare it before
-/// they share the model: ranks whose problem files differ (E on one rank, another punch force)
-/// deadlocked after the first Newton iteration or ignored the difference.
-pub fn inputs_hash(p: &Problem, mesh: &stamp::mesh::QuadMesh) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut eat = |bytes: &[u8]| {
-        for &b in bytes {
-            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
-        }
-    };
-    eat(p.source.as_bytes());
-    for x in &mesh.coords {
-        eat(&x[0].to_bits().to_le_bytes());
-        eat(&x[1].to_bits().to_le_bytes());
-    }
-    for c in &mesh.cells {
-        for &n in c {
-            eat(&(n as u64).to_le_bytes());
-        }
-    }
-    h
-}
-
-/// Every rank's [`inputs_hash`] the same, or the error that stops them all (collective).
-#[cfg(feature = "petsc")]
-fn same_inputs(petsc: &stamp_petsc::Petsc, h: u64) -> Result<()> {
-    let (mut hi, mut lo) = ([h], [h]);
-    petsc.max_u64(&mut hi)?;
-    petsc.min_u64(&mut lo)?;
-    if hi != lo {
-        return Err(stamp::StampError::Problem(format!(
-            "the ranks read different problems (rank {} read one whose problem file or mesh hashes to {h:016x}; another rank's differs): every rank must read the same problem file and mesh",
-            petsc.rank()
-        )));
-    }
-    Ok(())
-}
-
 pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, linear: &mut Linear, inputs: u64) -> Result<()> {
     #[cfg(not(feature = "petsc"))]
     {
@@ -184,7 +175,9 @@ pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, lin
         if p <= 1 {
             return Ok(());
         }
-        same_inputs(&petsc, inputs)?;
+        same_on_every_rank(&petsc, inputs, || {
+            format!("the ranks read different problems (rank {rank} read one whose problem file or mesh hashes to {inputs:016x}; another rank's differs): every rank must read the same problem file and mesh")
+        })?;
         let (ne, nn) = (model.element.num_elements(), model.dofs.num_nodes());
         if ne < p {
             // fewer elements than ranks: every rank evaluates the whole model
@@ -195,13 +188,7 @@ pub fn share<E: stamp::element::Element>(model: &mut stamp::model::Model<E>, lin
         let part = partition_elements(nn, ne, nodes, p)?;
         // METIS is deterministic: every rank computed the same parts (checked, since a rank that
         // disagreed would wait for ever in a collective call)
-        let h = part.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &x| (h ^ x as u64).wrapping_mul(0x0100_0000_01b3));
-        let (mut hi, mut lo) = ([h], [h]);
-        petsc.max_u64(&mut hi)?;
-        petsc.min_u64(&mut lo)?;
-        if hi != lo {
-            return Err(stamp::StampError::Problem("the ranks partitioned the mesh differently".into()));
-        }
+        same_on_every_rank(&petsc, fnv(FNV_START, part.iter().flat_map(|x| x.to_le_bytes())), || "the ranks partitioned the mesh differently".into())?;
         let owner = node_owners(nn, ne, nodes, &part);
         let dpn = model.dofs.dofs_per_node();
         let mut equation_owner = vec![0u32; model.dofs.num_equations()];
