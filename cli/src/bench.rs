@@ -2,10 +2,13 @@
 //! quarter model), solved on n x n structured meshes with the same loads at every size, timing
 //! each phase of the solve.
 //!
-//! Two problems ([`BenchProblem`]): the default one built here (side 100, R = 50, the sphere
-//! moved down 2 in one load target, growing increments), and `meshes/sphere-ss-displacement.toml`
-//! (side 40, R = 200, moved down 0.9 in 5 targets, augmented Lagrangian) built by `stamp run`'s
-//! own pipeline from that file with its mesh's `n` replaced, so that it is the users' problem.
+//! Three problems ([`BenchProblem`]): the default one built here (side 100, R = 50, the sphere
+//! moved down 2 in one load target, growing increments), `meshes/sphere-ss-displacement.toml`
+//! (side 40, R = 200, moved down 0.9 in 5 targets, augmented Lagrangian) and
+//! `meshes/sphere-slide.toml` (a sphere pressed into a plate on a table, then slid 12 along x1),
+//! the two files built by `stamp run`'s own pipeline with their mesh's `n` replaced, so that they
+//! are the users' problems. `--friction mu` gives the punch Coulomb friction: the cost of a Newton
+//! iteration with and without it on the same problem (docs/performance.md, "Friction").
 //!
 //! Every size runs in a child process of its own (`stamp bench --one N`), so that its peak
 //! resident memory is its own and no size warms the caches of the next.
@@ -40,6 +43,8 @@ pub const PUNCH_TRAVEL: f64 = 2.0;
 pub const DEFAULT_SIZES: [usize; 5] = [25, 50, 100, 200, 400];
 /// The default sizes of `stamp bench --problem sphere-displacement`.
 pub const DISPLACEMENT_SIZES: [usize; 5] = [10, 20, 40, 80, 160];
+/// The default sizes of `stamp bench --problem sphere-slide` (4n x n cells).
+pub const SLIDE_SIZES: [usize; 4] = [8, 16, 32, 64];
 
 /// Which problem `stamp bench` solves.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -50,6 +55,9 @@ pub enum BenchProblem {
     /// `meshes/sphere-ss-displacement.toml`: the sphere (R = 200) moved down 0.9 onto the plate of
     /// side 40 in 5 equal targets (max_increment 0.2), augmented Lagrangian to a penetration of 1e-6.
     SphereDisplacement,
+    /// `meshes/sphere-slide.toml`: a sphere (R = 200) pressed 0.05 into a plate (h = 1) on a
+    /// table, then slid 12 along x1, half model on 4n x n cells (the file's 30 x 8 at about n = 8).
+    SphereSlide,
 }
 
 impl BenchProblem {
@@ -58,6 +66,7 @@ impl BenchProblem {
         match self {
             BenchProblem::Sphere => "sphere",
             BenchProblem::SphereDisplacement => "sphere-displacement",
+            BenchProblem::SphereSlide => "sphere-slide",
         }
     }
 
@@ -66,6 +75,7 @@ impl BenchProblem {
         match self {
             BenchProblem::Sphere => &DEFAULT_SIZES,
             BenchProblem::SphereDisplacement => &DISPLACEMENT_SIZES,
+            BenchProblem::SphereSlide => &SLIDE_SIZES,
         }
     }
 }
@@ -86,6 +96,9 @@ const DISPLACEMENT_PROBLEM: &str = include_str!("../../meshes/sphere-ss-displace
 const DISPLACEMENT_MESH_N: &str = "n = [10, 10]";
 /// Its [solver] table's header, after which `--predictor coarse` adds its key.
 const DISPLACEMENT_SOLVER: &str = "[solver]\n";
+/// The problem file of [`BenchProblem::SphereSlide`], its mesh line as in the file.
+const SLIDE_PROBLEM: &str = include_str!("../../meshes/sphere-slide.toml");
+const SLIDE_MESH_N: &str = "n = [30, 8]";
 
 /// Seconds spent in each phase.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
@@ -211,6 +224,8 @@ pub struct SolverOptions {
     pub problem: BenchProblem,
     /// Where each load step starts (sphere-displacement only).
     pub predictor: BenchPredictor,
+    /// The punch's Coulomb friction coefficient (0: frictionless, the problem as it is).
+    pub friction: f64,
 }
 
 /// The model, the load targets and the settings of `meshes/sphere-ss-displacement.toml` on an
@@ -222,6 +237,17 @@ fn build_displacement(n: usize, predictor: BenchPredictor) -> Result<(stamp_prob
         source = source.replacen(DISPLACEMENT_SOLVER, &format!("{DISPLACEMENT_SOLVER}predictor = \"coarse\"\n"), 1);
     }
     let p = stamp_problem::Problem::parse(std::path::Path::new("meshes/sphere-ss-displacement.toml"), source)?;
+    let setup = stamp_problem::build::build(&p)?;
+    let targets = setup.targets.clone();
+    Ok((setup, targets))
+}
+
+/// The model, the load targets and the settings of `meshes/sphere-slide.toml` on 4n x n cells,
+/// built as `stamp run` builds them.
+fn build_slide(n: usize) -> Result<(stamp_problem::build::Setup, Vec<f64>)> {
+    debug_assert!(SLIDE_PROBLEM.contains(SLIDE_MESH_N));
+    let source = SLIDE_PROBLEM.replacen(SLIDE_MESH_N, &format!("n = [{}, {n}]", 4 * n), 1);
+    let p = stamp_problem::Problem::parse(std::path::Path::new("meshes/sphere-slide.toml"), source)?;
     let setup = stamp_problem::build::build(&p)?;
     let targets = setup.targets.clone();
     Ok((setup, targets))
@@ -246,7 +272,14 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
             let coarse = setup.coarse.map(|c| stamp_problem::coarse::solve_coarse(*c, &targets));
             (setup.model, setup.mesh.mesh, setup.settings, targets, coarse)
         }
+        BenchProblem::SphereSlide => {
+            let (setup, targets) = build_slide(n)?;
+            (setup.model, setup.mesh.mesh, setup.settings, targets, None)
+        }
     };
+    if options.friction != 0.0 {
+        model.contacts[0].set_friction(options.friction)?;
+    }
     // (no force-driven punch in either problem: `stamp run`'s BorderedSolver would be this solver)
     let mut newton = NewtonRaphson::new(LdltGmres::new().reuse(options.reuse).with_preconditioner(!options.symmetric_part), settings);
     let coarse = match coarse {
@@ -275,7 +308,9 @@ pub fn run_one(n: usize, options: SolverOptions) -> Result<BenchRun> {
 
     let mt = model.timings;
     let st = newton.linear.timings();
-    let reaction = -4.0 * model.contacts[0].reaction()[2];
+    // the quarter models' force times 4, the half model's times 2
+    let copies = if options.problem == BenchProblem::SphereSlide { 2.0 } else { 4.0 };
+    let reaction = -copies * model.contacts[0].reaction()[2];
     Ok(BenchRun {
         n,
         unknowns: model.num_equations(),
@@ -315,6 +350,7 @@ pub fn run_sizes(sizes: &[usize], options: SolverOptions, mut on_run: impl FnMut
             .args(if options.symmetric_part { &["--symmetric-part"][..] } else { &[][..] })
             .args(["--problem", options.problem.name()])
             .args(if options.predictor == BenchPredictor::Coarse { &["--predictor", "coarse"][..] } else { &[][..] })
+            .args(["--friction", &options.friction.to_string()])
             .output()
             .map_err(|e| StampError::io(&exe, e))?;
         if !out.status.success() {
@@ -332,7 +368,11 @@ pub fn header(options: SolverOptions) -> String {
     let mut title = match options.problem {
         BenchProblem::Sphere => format!("simply supported square plate (side {SIDE}, h = {THICKNESS}, quarter model) under a sphere (R = {RADIUS}, travel {PUNCH_TRAVEL})"),
         BenchProblem::SphereDisplacement => "meshes/sphere-ss-displacement.toml: simply supported square plate (side 40, h = 1, quarter model) under a sphere (R = 200, travel 0.9, 5 targets)".into(),
+        BenchProblem::SphereSlide => "meshes/sphere-slide.toml: a sphere (R = 200) pressed 0.05 into a plate (h = 1) on a table, then slid 12 along x1 (half model, 4n x n cells, 10 targets)".into(),
     };
+    if options.friction != 0.0 {
+        title.push_str(&format!(";\nfriction = {} between the punch and the plate", options.friction));
+    }
     if options.predictor == BenchPredictor::Coarse {
         title.push_str(";\npredictor = \"coarse\": every load step starts from the solution on the mesh with half the n");
     }

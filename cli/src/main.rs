@@ -64,14 +64,18 @@ enum Command {
         /// the GMRES iterations): for comparison.
         #[arg(long)]
         symmetric_part: bool,
-        /// The problem: `sphere` (the default: R = 50 moved down 2 onto the plate of side 100) or
-        /// `sphere-displacement` (meshes/sphere-ss-displacement.toml on n x n meshes).
+        /// The problem: `sphere` (the default: R = 50 moved down 2 onto the plate of side 100),
+        /// `sphere-displacement` (meshes/sphere-ss-displacement.toml on n x n meshes) or
+        /// `sphere-slide` (meshes/sphere-slide.toml on 4n x n meshes).
         #[arg(long, value_enum, default_value = "sphere")]
         problem: stamp_cli::bench::BenchProblem,
         /// With --problem sphere-displacement: start every load step from the solution on the
         /// mesh with half the n (`[solver] predictor = "coarse"`) instead of the secant predictor.
         #[arg(long, value_enum, default_value = "secant")]
         predictor: stamp_cli::bench::BenchPredictor,
+        /// Coulomb friction coefficient between the punch and the plate (default 0: frictionless).
+        #[arg(long, default_value_t = 0.0)]
+        friction: f64,
         /// Run one size in this process and print its JSON (used by `stamp bench` for each size).
         #[arg(long, hide = true)]
         one: Option<usize>,
@@ -111,10 +115,10 @@ fn main() -> ExitCode {
         Some(Command::Paper { json, plot }) => stamp_cli::paper::paper_command(json, plot.as_deref().filter(|_| writes)),
         Some(Command::Run { problem, out, quiet, refine }) => stamp_cli::commands::run_command(&problem, out.as_deref(), quiet, refine.map(usize::from)),
         Some(Command::Check { problem }) => stamp_cli::commands::check_command(&problem),
-        Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, predictor, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor }),
-        Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, predictor, one: None }) => {
+        Some(Command::Bench { one: Some(n), reuse, symmetric_part, problem, predictor, friction, .. }) => stamp_cli::bench::one_command(n, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor, friction }),
+        Some(Command::Bench { sizes, json, reuse, symmetric_part, problem, predictor, friction, one: None }) => {
             let sizes = sizes.unwrap_or_else(|| problem.default_sizes().to_vec());
-            stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor })
+            stamp_cli::bench::bench_command(&sizes, json, stamp_cli::bench::SolverOptions { reuse, symmetric_part, problem, predictor, friction })
         }
     };
     // a reader that closed stdout early is no error; a stdout that cannot be written (a full disk,

@@ -95,8 +95,9 @@ impl ContactPair {
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
             // a point that cycled keeps the active-side tangent near the kink (its force stays exact)
             let near_kink = !self.hold_active_set && self.frozen[k] && with_tangent && trial <= rules.band;
-            if self.friction.is_some() {
-                self.add_friction(k, lambda, active, &grad, hess.as_ref(), &dn, force, with_tangent);
+            if self.friction.is_some() && self.add_friction(k, lambda, active, &grad, hess.as_ref(), &dn, force, with_tangent) && own(k) {
+                // held on a branch of the friction cone that is not the cone's own
+                changes += 1;
             }
             if !active && !near_kink {
                 continue;
@@ -122,6 +123,10 @@ impl ContactPair {
         if debug && share.is_none_or(|s| s.leader) {
             let [deferred, tensile, entering, penetrating, held] = tally;
             eprintln!("  {}: {act} active, {penetrating} penetrating; {entering} would enter ({deferred} deferred), {tensile} would leave ({held} held)", self.name);
+            if let Some(f) = &self.friction {
+                let count = |w: u8| f.status.iter().enumerate().filter(|&(k, &s)| own(k) && s == w).count();
+                eprintln!("  {} friction: {} sticking, {} slipping", self.name, count(super::STICK), count(super::SLIP));
+            }
         }
         if let Some(f) = &drive {
             // the load once over the processes

@@ -87,6 +87,9 @@ impl ContactPair {
         self.entered_deep.fill(false);
         self.flips.fill(0);
         self.frozen.fill(false);
+        if let Some(f) = &mut self.friction {
+            f.laws.start_step();
+        }
         self.step_start = true;
         self.kept_last = false;
         // over this process's points: the next evaluation takes the largest over the processes
@@ -111,6 +114,12 @@ impl ContactPair {
                 record_flip(&mut self.flips[k], &mut self.frozen[k], self.max_flips);
             }
         }
+        // the stick/slip criterion: the points held on the other branch of the friction cone
+        let share = self.share.take();
+        if let Some(f) = &mut self.friction {
+            changes += f.laws.update(|k| share.as_ref().is_none_or(|s| s.own[k]), |k| share.as_ref().is_none_or(|s| s.evaluated[k]));
+        }
+        self.share = share;
         if let Some(sh) = &self.share {
             let mut c = [changes as f64];
             sh.reduce.sum(&mut c)?;

@@ -18,6 +18,7 @@
 //! a <- x - (t - lambda_T_bar) / eps_T (the return map: the next trial at the same place is t),
 //! and sets an open point's anchor where it is.
 
+use super::stick_slip::StickSlip;
 use super::ContactPair;
 use nalgebra::{Matrix3, Vector3};
 
@@ -26,20 +27,29 @@ impl ContactPair {
     /// position `x` in the punch's frame (where the Hessian is taken), its force w t on the
     /// point's displacement and -w t . n on a force-driven punch's equation (direction `dn`: the
     /// point's position in the punch's frame moves by -dn with the punch's travel), and with
-    /// `with_tangent` its tangent entries into the friction's list (the model adds them).
+    /// `with_tangent` its tangent entries into the friction's list (the model adds them). The
+    /// point is held on the stick or slip branch that the stick/slip criterion chose
+    /// ([`StickSlip`]); returns true when that branch is not the return map's own (a change of
+    /// the active set: Newton does not stop on it).
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn add_friction(&mut self, k: usize, lambda: f64, active: bool, grad: &Vector3<f64>, x: Option<&Vector3<f64>>, dn: &Vector3<f64>, force: &mut [f64], with_tangent: bool) {
+    pub(super) fn add_friction(&mut self, k: usize, lambda: f64, active: bool, grad: &Vector3<f64>, x: Option<&Vector3<f64>>, dn: &Vector3<f64>, force: &mut [f64], with_tangent: bool) -> bool {
         let (p, eps_reg, drive) = (self.points[k], self.eps_reg, self.drive);
-        let Some(x) = x.copied() else { return };
+        let Some(x) = x.copied() else { return false };
         let hess = if active { Some(self.surface.hessian(&x)) } else { None };
-        let Some(f) = &mut self.friction else { return };
+        let Some(f) = &mut self.friction else { return false };
         f.position[k] = x.into();
         let Some(hess) = hess else {
             f.traction[k] = [0.0; 3];
             f.status[k] = OPEN;
-            return;
+            f.laws.open(k, with_tangent);
+            return false;
         };
-        let pf = return_map(f.mu, f.eps_t, &x, &Vector3::from(f.anchor[k]), &Vector3::from(f.lambda_t_bar[k]), lambda, &(grad * eps_reg), grad, &hess);
+        let (a, lt) = (Vector3::from(f.anchor[k]), Vector3::from(f.lambda_t_bar[k]));
+        let natural = return_map(f.mu, f.eps_t, &x, &a, &lt, lambda, &(grad * eps_reg), grad, &hess);
+        // the branch the stick/slip criterion holds this point on (stick_slip.rs)
+        let branch = f.laws.branch(k, &natural, with_tangent);
+        let pf = if branch == natural.status { natural } else { return_map_on(Some(branch), f.mu, f.eps_t, &x, &a, &lt, lambda, &(grad * eps_reg), grad, &hess) };
+        let inconsistent = with_tangent && f.laws.inconsistent(k, &natural);
         f.traction[k] = pf.traction.into();
         f.status[k] = pf.status;
         let w = p.weight;
@@ -50,7 +60,7 @@ impl ContactPair {
             force[d.dof] -= w * pf.traction.dot(dn);
         }
         if !with_tangent {
-            return;
+            return inconsistent;
         }
         let j = pf.jacobian * w;
         for r in 0..3 {
@@ -67,6 +77,7 @@ impl ContactPair {
             }
             f.entries.push((d.dof, d.dof, dn.dot(&jn), 0.0));
         }
+        inconsistent
     }
 
     /// The friction's tangent entries of the last evaluation with a tangent (row dof, column dof,
@@ -114,6 +125,8 @@ pub struct Friction {
     pub slip: Vec<f64>,
     /// The energy dissipated by friction at each point over the converged steps (w t . slip).
     pub dissipation: Vec<f64>,
+    /// The branch each point is held on while Newton converges (the stick/slip criterion).
+    pub laws: StickSlip,
     /// The tangent entries of the last evaluation with a tangent: (row dof, column dof, value,
     /// value for the symmetric preconditioner).
     pub(super) entries: Vec<(usize, usize, f64, f64)>,
@@ -134,6 +147,7 @@ impl Friction {
             status: vec![OPEN; n],
             slip: vec![0.0; n],
             dissipation: vec![0.0; n],
+            laws: StickSlip::new(n),
             entries: Vec::new(),
         }
     }
@@ -195,6 +209,10 @@ pub struct PointFriction {
     /// A symmetric positive semi-definite stand-in for `jacobian` in the preconditioner:
     /// eps_T P in stick, mu q eps_T (P - s s^T) / |t_tr| in slip.
     pub symmetric: Matrix3<f64>,
+    /// The trial traction P (lambda_T_bar + eps_T (x - a)).
+    pub trial: Vector3<f64>,
+    /// Its size against the bound: |trial| / (mu q) (infinite without pressure).
+    pub cone_ratio: f64,
     pub status: u8,
 }
 
@@ -203,7 +221,17 @@ pub struct PointFriction {
 /// derivative with respect to x (eps_reg grad Psi on the active branch, zero off it), `grad` and
 /// `hess` grad Psi and its Hessian at x. `hess` None: a flat punch (no rotation of n).
 #[allow(clippy::too_many_arguments)]
-pub fn return_map(
+pub fn return_map(mu: f64, eps_t: f64, x: &Vector3<f64>, a: &Vector3<f64>, lambda_t_bar: &Vector3<f64>, lambda: f64, dlambda: &Vector3<f64>, grad: &Vector3<f64>, hess: &Matrix3<f64>) -> PointFriction {
+    return_map_on(None, mu, eps_t, x, a, lambda_t_bar, lambda, dlambda, grad, hess)
+}
+
+/// [`return_map`] on a given branch: `Some(STICK)` the trial traction whatever its size,
+/// `Some(SLIP)` mu q along the trial traction wherever that points (inside the cone too), None
+/// the branch the cone decides. A point out of contact (q = 0) slips with no traction whatever
+/// the branch asked for.
+#[allow(clippy::too_many_arguments)]
+pub fn return_map_on(
+    branch: Option<u8>,
     mu: f64,
     eps_t: f64,
     x: &Vector3<f64>,
@@ -216,7 +244,7 @@ pub fn return_map(
 ) -> PointFriction {
     let gn = grad.norm();
     if gn == 0.0 {
-        return PointFriction { traction: Vector3::zeros(), jacobian: Matrix3::zeros(), symmetric: Matrix3::zeros(), status: OPEN };
+        return PointFriction { traction: Vector3::zeros(), jacobian: Matrix3::zeros(), symmetric: Matrix3::zeros(), trial: Vector3::zeros(), cone_ratio: f64::INFINITY, status: OPEN };
     }
     let n = grad / gn;
     let p = Matrix3::identity() - n * n.transpose();
@@ -230,17 +258,22 @@ pub fn return_map(
     // the normal pressure q = -lambda |grad Psi| and its derivative
     let (q, dq) = if lambda < 0.0 { (-lambda * gn, -(dlambda * gn + hess * grad * (lambda / gn))) } else { (0.0, Vector3::zeros()) };
     let norm = trial.norm();
-    if q > 0.0 && norm <= mu * q {
-        return PointFriction { traction: trial, jacobian: dtrial, symmetric: p * eps_t, status: STICK };
+    let stick = match branch {
+        Some(b) => b == STICK,
+        None => norm <= mu * q,
+    };
+    let cone_ratio = if q > 0.0 { norm / (mu * q) } else { f64::INFINITY };
+    if q > 0.0 && stick {
+        return PointFriction { traction: trial, jacobian: dtrial, symmetric: p * eps_t, trial, cone_ratio, status: STICK };
     }
     if norm == 0.0 {
-        return PointFriction { traction: Vector3::zeros(), jacobian: Matrix3::zeros(), symmetric: Matrix3::zeros(), status: SLIP };
+        return PointFriction { traction: Vector3::zeros(), jacobian: Matrix3::zeros(), symmetric: Matrix3::zeros(), trial, cone_ratio, status: SLIP };
     }
     let s = trial / norm;
     let ps = Matrix3::identity() - s * s.transpose();
     let jacobian = s * dq.transpose() * mu + ps * dtrial * (mu * q / norm);
     let symmetric = (p - s * s.transpose()) * (mu * q * eps_t / norm);
-    PointFriction { traction: s * (mu * q), jacobian, symmetric, status: SLIP }
+    PointFriction { traction: s * (mu * q), jacobian, symmetric, trial, cone_ratio, status: SLIP }
 }
 
 #[cfg(test)]
