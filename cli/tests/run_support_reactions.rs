@@ -139,7 +139,9 @@ fn support_reactions_balance_the_punches_and_the_loads() {
     // (steel: a pressure of 0.5, 200 on the quarter against the sphere's 500; the laminate, E2 =
     // 1e4, 0.01)
     let (steel, soft) = (corner_and_pressure(0.5), corner_and_pressure(0.01));
-    let cases: Vec<(&str, &str, Vec<(&str, &str)>, Vec<(&str, f64)>, &str)> = vec![
+    // (name, shipped problem, its edits, the groups' weights, the punch)
+    type Case<'a> = (&'a str, &'a str, Vec<(&'a str, &'a str)>, Vec<(&'a str, f64)>, &'a str);
+    let cases: Vec<Case> = vec![
         ("sphere-pressure", "sphere-ss.toml", vec![("[[punch]]", &steel)], QUARTER.to_vec(), "sphere"),
         ("cylinder", "cylinder-30deg.toml", vec![], vec![("bottom", 1.0), ("top", 1.0)], "cylinder"),
         ("four-surfaces", "sphere-ss-4surfaces.toml", vec![("[[punch]]", &steel)], QUARTER.to_vec(), "sphere"),
