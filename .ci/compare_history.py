@@ -4,12 +4,18 @@ value within TOL relative to its column's scale, |a - b| <= TOL * scale, the sca
 largest magnitude in the column (both files) and, for the displacement columns (names ending
 _u1, _u2, _u3), the largest displacement of any of them: a displacement that is zero by symmetry
 holds round-off (1e-17) and is judged on the size of the displacements, not on its own noise;
-likewise a punch's force components (_force_x1, _x2, _x3) on the size of its force.
+likewise a punch's force components (_force_x1, _x2, _x3) on the size of its force, and a
+support group's reaction components (<group>_reaction_x1, _x2, _x3) on the size of the largest
+force of the run, any punch force or support reaction (the supports balance the punches and the
+loads: a component that is zero by symmetry, or the small share of a lightly loaded group, holds
+round-off of the forces in play).
 Prints the worst column; exit 1 on a difference."""
 import csv
 import sys
 
 TOL = 1e-8
+REACTION = ("_reaction_x1", "_reaction_x2", "_reaction_x3")
+FORCE = ("_force", "_force_x1", "_force_x2", "_force_x3")
 
 
 def read(path):
@@ -35,6 +41,8 @@ def main(ref_path, new_path, tol=TOL):
 
     displacement = [c for c, name in enumerate(h1) if name.endswith(("_u1", "_u2", "_u3"))]
     u_scale = max([abs(x) for c in displacement for x in numbers(c)] + [0.0])
+    forces = [c for c, name in enumerate(h1) if name.endswith(REACTION + FORCE)]
+    f_scale = max([abs(x) for c in forces for x in numbers(c)] + [0.0])
     worst = (0.0, "", 0)
     for c, name in enumerate(h1):
         try:
@@ -52,6 +60,8 @@ def main(ref_path, new_path, tol=TOL):
             if name.endswith(suffix):
                 punch = name[: -len(suffix)]
                 scale = max([abs(x) for k, n in enumerate(h1) if n.startswith(punch + "_force") for x in numbers(k)] + [0.0])
+        if name.endswith(REACTION):
+            scale = f_scale
         for k, (x, y) in enumerate(zip(a, b)):
             d = abs(x - y) / scale if scale > 0 else 0.0
             if d > worst[0]:

@@ -2,7 +2,9 @@
 //! for three processes, with a reduction over them. At a large-displacement state with points in
 //! contact with a force-driven punch and a follower pressure, every share's residual, energy and
 //! contact state are the whole model's, the shares' tangents and preconditioners add up to the
-//! whole model's in the nodal block, and the punch's row and column are whole in every share.
+//! whole model's in the nodal block, and the punch's row and column are whole in every share; so
+//! are the nodal forces at every dof and the follower loads' forces (the supports' reactions that
+//! `stamp run` writes are read from them at the held dofs on every rank).
 //! Each share's pattern is its own, smaller than the whole's, and holds the whole rows of the
 //! nodes it owns. Each share keeps its own elements' data only; an element that refuses the state
 //! on one share gives every share the same error, its reason told by that share.
@@ -137,8 +139,9 @@ fn contact_model(mesh: &QuadMesh, integrated: bool, surface: Arc<dyn ContactSurf
 /// A sparse matrix's stored entries (zeros too), (row, column) -> value.
 type Entries = BTreeMap<(usize, usize), f64>;
 
-/// (residual, energy, active flags, tangent, preconditioner) at `u`, or the error.
-type Outcome = std::result::Result<(Vec<f64>, f64, Vec<bool>, Entries, Entries), String>;
+/// (residual, energy, active flags, tangent, preconditioner, the nodal forces over all dofs
+/// followed by the follower loads' forces) at `u`, or the error.
+type Outcome = std::result::Result<(Vec<f64>, f64, Vec<bool>, Entries, Entries, Vec<f64>), String>;
 
 fn entries(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Entries {
     let (cp, ri) = (m.symbolic().col_ptr(), m.symbolic().row_idx());
@@ -150,7 +153,8 @@ fn evaluate(model: &mut Model<PlateElements>, u: &[f64]) -> Outcome {
     // the points' state whole on every share (collective)
     model.contacts[0].gather_state().map_err(|e| e.to_string())?;
     let active = model.contacts[0].state.iter().map(|s| s.active).collect();
-    Ok((model.residual().to_vec(), model.energy(), active, entries(model.matrix()), entries(model.preconditioner().unwrap())))
+    let forces = model.nodal_forces().iter().chain(model.follower_forces()).copied().collect();
+    Ok((model.residual().to_vec(), model.energy(), active, entries(model.matrix()), entries(model.preconditioner().unwrap()), forces))
 }
 
 /// The PARTS shares of METIS's partition of the mesh over one reduction, each with its elements'
@@ -215,7 +219,11 @@ fn shares_add_up_to_the_whole_model() {
     }
     u[n - 1] = 0.12;
     whole.apply_prescribed(&mut u, 1.0);
-    let (r, energy, active, k, p) = evaluate(&mut whole, &u).unwrap();
+    let (r, energy, active, k, p, forces) = evaluate(&mut whole, &u).unwrap();
+    // the clamped edge's reactions are not zero, nor are the follower pressure's forces there
+    let held: Vec<usize> = (0..whole.dofs.num_dofs()).filter(|&d| whole.dofs.equation(d).is_none()).collect();
+    assert!(held.iter().any(|&d| forces[d].abs() > 1e-6) && held.iter().any(|&d| whole.follower_forces()[d].abs() > 1e-6));
+    let fscale = forces.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(active.iter().filter(|a| **a).count() >= 3, "points in contact: {}", active.iter().filter(|a| **a).count());
     let scale = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let kscale = k.values().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -231,7 +239,9 @@ fn shares_add_up_to_the_whole_model() {
         }
     }
     for (i, o) in outcomes.iter().enumerate() {
-        let (ri, ei, ai, ki, pi) = o.as_ref().unwrap();
+        let (ri, ei, ai, ki, pi, fi) = o.as_ref().unwrap();
+        let df = forces.iter().zip(fi).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(fi.len() == forces.len() && df <= 1e-12 * fscale, "share {i}: nodal or follower forces differ by {df:e} of {fscale:e}");
         let dr = r.iter().zip(ri).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(dr <= 1e-12 * scale, "share {i}: residual differs by {dr:e} of {scale:e}");
         assert!((ei - energy).abs() <= 1e-12 * energy.abs(), "share {i}: energy {ei} against {energy}");

@@ -199,7 +199,8 @@ class Result:
 
     @property
     def summary(self):
-        """summary.json as a dict."""
+        """summary.json as a dict (per step in ``summary["steps"]``: the punches' ``reaction``, the
+        supports' ``support_reaction`` and, per ``[[boundary]]`` group, ``support_reactions``)."""
         if self._summary is None:
             self._summary = _json.loads(self._r.summary_json)
         return self._summary
@@ -208,7 +209,9 @@ class Result:
     def history(self):
         """history.csv as a dict of numpy arrays, one per column (``step`` int64, the rest float64):
         ``load_factor``, ``path``, ``<punch>_travel``, ``<punch>_force``, ``<punch>_contact_area``,
-        ``<punch>_max_pressure`` and ``<point group>_u1/_u2/_u3``; a row per converged step."""
+        ``<punch>_max_pressure``, ``<point group>_u1/_u2/_u3``, ``<punch>_force_x1/_x2/_x3`` (and
+        ``<punch>_dissipation`` with friction) and last, per ``[[boundary]]`` group, its support
+        reaction ``<group>_reaction_x1/_x2/_x3``; a row per converged step."""
         lines = self._r.history_csv.strip("\n").split("\n")
         header = lines[0].split(",")
         rows = [line.split(",") for line in lines[1:]]

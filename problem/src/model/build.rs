@@ -36,6 +36,7 @@
 use crate::checks::rigid_modes::num;
 use crate::model::mesh::{group_error, MeshData};
 use crate::model::plate_model::{Layout, Plate};
+use crate::outputs::supports::Supports;
 use crate::schema::{ContactKinematicsSpec, ContactSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape, DEFAULT_MAX_INCREMENT};
 use nalgebra::Vector3;
 use stamp::contact::{automatic_eps_reg, ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
@@ -76,6 +77,8 @@ pub struct Setup {
     /// `[solver] predictor = "coarse"`: the same problem on the coarse mesh (solved first, see
     /// crate::model::coarse); None otherwise, and on the meshes of `--refine`.
     pub coarse: Option<Box<CoarseSetup>>,
+    /// The `[[boundary]]` groups and the dofs each holds: their reactions are written per step.
+    pub supports: Supports,
 }
 
 /// The problem on the coarse mesh of `predictor = "coarse"` and the map of its nodal fields
@@ -252,7 +255,7 @@ fn build_coarse(p: &Problem, fine: &MeshData) -> Result<CoarseSetup> {
 pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
     let PlateBuild { plate, section, young, kinematics } = build_plate(p, &mesh)?;
     let layout = Layout::of(&plate);
-    let dofs = build_boundary(p, &mesh, &layout)?;
+    let (dofs, supports) = build_boundary(p, &mesh, &layout)?;
     let mut model = Model::new(plate, dofs).map_err(|e| match e {
         e @ StampError::Mesh(_) => mesh_error(p, &mesh, e),
         e => StampError::Input { file: p.path.display().to_string(), message: e.to_string() },
@@ -261,7 +264,7 @@ pub fn build_on(p: &Problem, mesh: MeshData) -> Result<Setup> {
     let punches = build_punches(p, &mesh, &section, young, kinematics, &layout, &mut model)?;
     let stiffness = stiffness_force(&mesh, &section, young);
     let settings = build_solver(p, &mut model, stiffness)?;
-    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, stiffness, coarse: None })
+    Ok(Setup { mesh, model, section, punches, targets: p.targets(), settings, stiffness, coarse: None, supports })
 }
 
 /// The plate of `[plate]` (with the `[[material]]` tables of its layers): its elements, the
@@ -326,12 +329,13 @@ fn build_plate(p: &Problem, mesh: &MeshData) -> Result<PlateBuild> {
 }
 
 /// `[[boundary]]` (and `[plate] plane_strain`): the components held at zero or prescribed, by
-/// group.
-fn build_boundary(p: &Problem, mesh: &MeshData, layout: &Layout) -> Result<DofMap> {
+/// group; and the dofs each group holds (plane_strain's are no group's).
+fn build_boundary(p: &Problem, mesh: &MeshData, layout: &Layout) -> Result<(DofMap, Supports)> {
     let s = &p.spec;
     let ps = s.plate.get_ref();
     let n_nodes = mesh.mesh.num_nodes();
     let mut dofs = DofMap::new(n_nodes, layout.dofs_per_node)?;
+    let mut supports = Supports::default();
     if ps.plane_strain {
         let all: Vec<usize> = (0..n_nodes).collect();
         dofs.fix(&all, &layout.fibre_components(&[0, 3]))?;
@@ -343,6 +347,8 @@ fn build_boundary(p: &Problem, mesh: &MeshData, layout: &Layout) -> Result<DofMa
         let nodes = mesh.nodes(name).ok_or_else(|| group_error(p, bs.group.span(), &key, name, "", mesh))?;
         let comps: Vec<usize> = layout.fibre_components(&bs.fix.iter().flat_map(|d| d.components.clone()).collect::<Vec<_>>());
         dofs.fix(&nodes, &comps).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}]"), e))?;
+        let dpn = layout.dofs_per_node;
+        supports.hold(name, nodes.iter().flat_map(|&n| comps.iter().map(move |&c| n * dpn + c)));
         for (k, v) in &bs.prescribe {
             let comps = layout.fibre_components(&crate::schema::dof_components(&k.0).expect("checked word"));
             for &n in &nodes {
@@ -350,9 +356,10 @@ fn build_boundary(p: &Problem, mesh: &MeshData, layout: &Layout) -> Result<DofMa
                     dofs.prescribe(n, c, v.0).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}].prescribe"), e))?;
                 }
             }
+            supports.hold(name, nodes.iter().flat_map(|&n| comps.iter().map(move |&c| n * dpn + c)));
         }
     }
-    Ok(dofs)
+    Ok((dofs, supports))
 }
 
 /// `[[load]]`: line, surface, pressure, moment and point loads, as nodal forces of the model or

@@ -10,6 +10,9 @@
 //! * force: the reaction of the punch on the plate along d, so pressing is positive;
 //! * contact area: the sum of the tributary areas (contact weights) of the active nodes;
 //! * max pressure: the largest q_n; max penetration: the largest max(0, -Psi / |grad Psi|).
+//!
+//! Per `[[boundary]]` group, the reaction of its supports on the plate in global axes (see
+//! [`crate::outputs::supports`]), in the last columns.
 
 use crate::model::plate_model::Layout;
 use crate::outputs::plot::{write_plot, Plot, Series};
@@ -46,6 +49,8 @@ pub struct HistoryRow {
     pub points: Vec<[f64; 3]>,
     /// The mid-surface deflection u3 of largest magnitude over all nodes (with its sign).
     pub max_deflection: f64,
+    /// The reaction [f1, f2, f3] of each support group ([`History::support_names`]) on the plate.
+    pub supports: Vec<[f64; 3]>,
 }
 
 /// The direction along which a punch's travel and force are measured.
@@ -96,6 +101,8 @@ pub struct History {
     pub label_by_force: Vec<bool>,
     /// Named point groups (name, nodes).
     pub points: Vec<(String, Vec<usize>)>,
+    /// The `[[boundary]]` groups whose reactions the rows hold.
+    pub support_names: Vec<String>,
     pub rows: Vec<HistoryRow>,
     /// Where the plate keeps its surfaces' displacements among the unknowns.
     pub layout: Layout,
@@ -110,6 +117,7 @@ impl History {
             punch_faces: punches.iter().map(|p| p.1).collect(),
             label_by_force: punches.iter().map(|p| p.2).collect(),
             points: point_groups.iter().filter(|(k, _)| !k.starts_with('#')).cloned().collect(),
+            support_names: Vec::new(),
             rows: Vec::new(),
             layout: Layout::two_surface(),
         }
@@ -121,8 +129,16 @@ impl History {
         self
     }
 
-    /// Add the converged step `step` (unknowns `u`, load factor `t`, path length `path`).
-    pub fn record(&mut self, step: usize, t: f64, path: f64, newton_iterations: usize, contacts: &[ContactPair], u: &[f64]) -> &HistoryRow {
+    /// The same with the reactions of these support groups in its rows.
+    pub fn with_supports(mut self, names: Vec<String>) -> History {
+        self.support_names = names;
+        self
+    }
+
+    /// Add the converged step `step` (unknowns `u`, load factor `t`, path length `path`, the
+    /// reactions of the support groups `supports`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(&mut self, step: usize, t: f64, path: f64, newton_iterations: usize, contacts: &[ContactPair], u: &[f64], supports: Vec<[f64; 3]>) -> &HistoryRow {
         let punches = contacts.iter().zip(&self.punch_faces).map(|(c, &f)| punch_row(c, f, u, t)).collect();
         let points = self
             .points
@@ -141,7 +157,7 @@ impl History {
         // u holds the surfaces' displacements node by node, then one unknown per force-driven punch
         let nodes = (u.len() - contacts.iter().filter(|c| c.drive.is_some()).count()) / self.layout.dofs_per_node;
         let max_deflection = (0..nodes).map(|n| self.layout.mid_displacement(u, n)[2]).fold(0.0f64, |m, w| if w.abs() > m.abs() { w } else { m });
-        self.rows.push(HistoryRow { step, load_factor: t, path, newton_iterations, punches, points, max_deflection });
+        self.rows.push(HistoryRow { step, load_factor: t, path, newton_iterations, punches, points, max_deflection, supports });
         self.rows.last().expect("just pushed")
     }
 
@@ -163,6 +179,10 @@ impl History {
                 s.push_str(&format!(",{n}_dissipation"));
             }
         }
+        // last: the reaction of each support group in global axes
+        for g in &self.support_names {
+            s.push_str(&format!(",{g}_reaction_x1,{g}_reaction_x2,{g}_reaction_x3"));
+        }
         s.push('\n');
         for r in &self.rows {
             s.push_str(&format!("{},{:e},{:e}", r.step, r.load_factor, r.path));
@@ -178,6 +198,9 @@ impl History {
                 if let Some(d) = p.dissipation {
                     s.push_str(&format!(",{d:e}"));
                 }
+            }
+            for f in &r.supports {
+                s.push_str(&format!(",{:e},{:e},{:e}", f[0], f[1], f[2]));
             }
             s.push('\n');
         }
@@ -283,7 +306,7 @@ mod tests {
         let mut h = History::new(&[(name.into(), Face::Top, false)], &[]);
         for (k, &(t, travel)) in steps.iter().enumerate() {
             let punches = vec![PunchRow { travel, force: 10.0 * t, contact_area: 1.0, max_pressure: 1.0, max_penetration: 0.0, force_on_punch: [0.0; 3], dissipation: None }];
-            h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0 });
+            h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0, supports: vec![] });
         }
         let dir = std::env::temp_dir().join(format!("stamp-history-plot-{}-{name}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -1,12 +1,14 @@
 //! What a run writes: [`output`] (the .vtu fields, summary.json entries and contact CSV of a
 //! step), [`history`] (history.csv and the force-travel plot), [`table`] (the table on stdout),
-//! [`probe`] and [`thickness_probe`] (fields along a line and through the thickness, with the
-//! shears of [`equilibrium_shear`]) and [`plot`] (PNG/SVG line plots).
+//! [`supports`] (the reaction of each `[[boundary]]` group), [`probe`] and [`thickness_probe`]
+//! (fields along a line and through the thickness, with the shears of [`equilibrium_shear`]) and
+//! [`plot`] (PNG/SVG line plots).
 
 pub mod equilibrium_shear;
 pub mod history;
 pub mod output;
 pub mod plot;
 pub mod probe;
+pub mod supports;
 pub mod table;
 pub mod thickness_probe;

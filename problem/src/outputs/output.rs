@@ -140,6 +140,9 @@ pub struct StepEntry {
     pub reaction: [f64; 3],
     /// Total force of the supports (the prescribed dofs) on the plate.
     pub support_reaction: [f64; 3],
+    /// Per `[[boundary]]` group, the force of its supports on the plate (a dof held by two groups
+    /// counted in each: see [`crate::outputs::supports`]).
+    pub support_reactions: BTreeMap<String, [f64; 3]>,
     /// Total applied load (nodal loads times the load factor, and the follower loads in the
     /// deformed state). In equilibrium
     /// applied_load + reaction + support_reaction = 0.
@@ -253,6 +256,8 @@ pub struct Context<'a> {
     pub threshold: f64,
     /// Point groups reported in summary.json.
     pub point_groups: &'a [(String, Vec<usize>)],
+    /// The `[[boundary]]` groups whose reactions summary.json reports.
+    pub supports: &'a crate::outputs::supports::Supports,
 }
 
 /// Fields, summary entry and CSV rows of the state `u` at load factor `t`.
@@ -443,6 +448,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         loaded_zone: BBox::of(&loaded_pts),
         reaction,
         support_reaction: support,
+        support_reactions: cx.supports.names().into_iter().zip(cx.supports.reactions(model, t)).collect(),
         applied_load: applied,
         max_penetration: max_pen,
         points,

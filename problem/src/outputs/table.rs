@@ -93,6 +93,7 @@ mod tests {
                 punches: vec![PunchRow { travel: 0.5 * t, force: 500.0 * t, contact_area: 3.0, max_pressure: 12.5, max_penetration: 1e-7, force_on_punch: [0.0; 3], dissipation: None }],
                 points: vec![],
                 max_deflection: -0.1 * t,
+                supports: vec![],
             });
         }
         let units = Units { length: "mm".into(), force: "N".into(), pressure: "MPa".into(), area: "mm^2".into(), length_given: true, force_given: true };

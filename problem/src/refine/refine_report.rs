@@ -277,6 +277,7 @@ mod tests {
                 punches: vec![PunchRow { travel: t, force, contact_area: 1.0, max_pressure: 2.0, max_penetration: 0.0, force_on_punch: [0.0; 3], dissipation: None }],
                 points: vec![[0.0, 0.0, w]],
                 max_deflection: w,
+                supports: vec![],
             });
         }
         h

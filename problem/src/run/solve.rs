@@ -344,7 +344,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         crate::run::own_inputs::refuse_inputs_among_outputs(p, out_dir)?;
         crate::run::out_dir::RunFolder::claim(out_dir)
     })?;
-    let Setup { mesh, mut model, section, punches, targets, settings, coarse, .. } = setup;
+    let Setup { mesh, mut model, section, punches, targets, settings, coarse, supports, .. } = setup;
     let targets = opts.targets.clone().unwrap_or(targets);
     // the step budget of the path (a refined run passes through the targets it is given)
     let mut settings = settings;
@@ -387,7 +387,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let units = Units::new(p.spec.units.as_ref());
     let punch_names: Vec<String> = punches.iter().map(|i| i.name.clone()).collect();
     let punch_keys: Vec<_> = punches.iter().zip(&model.contacts).map(|(i, c)| (i.name.clone(), i.face, c.drive.is_some() || c.motion.is_zero())).collect();
-    let mut history = History::new(&punch_keys, &point_groups).with_layout(Layout::of(&model.element));
+    let mut history = History::new(&punch_keys, &point_groups).with_layout(Layout::of(&model.element)).with_supports(supports.names());
     let mut probes = Probes::new(p, &mesh, &out.probe, &punch_names)?;
     let thickness_probes = crate::outputs::thickness_probe::ThicknessProbes::new(p, &mesh)?;
 
@@ -478,7 +478,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
     let abort_note = writer.then(crate::run::abort_note::AbortNote::new);
     prepare_notes(abort_note.as_ref(), &summary_path, &summary, 0, 0.0);
 
-    let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups };
+    let cx = Context { mesh: &mesh, punches: &punches, section: &section, threshold: out.loaded_threshold.0, point_groups: &point_groups, supports: &supports };
     let progress = Progress::new(!quiet && std::io::stderr().is_terminal() && std::io::stdout().is_terminal(), !quiet, path_end);
     // force-driven punches border the system: block elimination keeps the sparse LU on the nodal part
     let mut newton = NewtonRaphson::new(BorderedSolver::with_inner(model.num_drives(), linear), settings);
@@ -545,7 +545,8 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         t_last = t;
         let penetration = m.contacts.iter().map(|c| c.max_penetration()).fold(0.0, f64::max);
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
-        let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u).clone();
+        // (the reactions are the whole model's on every rank: its forces are summed over them)
+        let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u, supports.reactions(m, t)).clone();
         // an interrupt from here on says this step converged, whether or not it is written
         prepare_notes(abort_note.as_ref(), &summary_path, &summary, rep.step, t);
         progress.step(rep, path_len, active, penetration, &history.terse_forces());
