@@ -137,15 +137,18 @@ fn a_rolling_cylinder_barely_drags_where_a_sliding_one_drags_mu_times_its_load()
 }
 
 /// A force-driven sphere turning 40 degrees about a tilted axis through its centre (the default
-/// pivot) has the same Psi at every load factor: frictionless, the same history to round-off.
+/// pivot) has the same Psi at every load factor: frictionless, the same history to round-off,
+/// with nodal and with integrated contact.
 #[test]
 fn a_force_driven_sphere_turning_about_its_centre_presses_as_one_that_does_not() {
-    let sphere = "name = \"ball\"\nshape = \"sphere\"\ncenter = [0.0, 0.0, 20.5]\nradius = 20.0\nforce = 2000.0\npenetration_tolerance = 1e-6\n";
-    let a = run("rotation-ball-still", &on_table(4.0, 8, sphere, 0.25));
-    let b = run("rotation-ball-turning", &on_table(4.0, 8, &format!("{sphere}rotation = [[1.0, 40.0]]\naxis = [1.0, 1.0, 0.3]\n"), 0.25));
-    let d = history_difference(&a, &b);
-    println!("force-driven sphere turning about its centre: history.csv differs by {d:e}");
-    assert!(d < 1e-9, "history.csv differs by {d:e}");
+    for contact in ["nodal", "integrated"] {
+        let sphere = format!("name = \"ball\"\nshape = \"sphere\"\ncenter = [0.0, 0.0, 20.5]\nradius = 20.0\nforce = 2000.0\npenetration_tolerance = 1e-6\ncontact = \"{contact}\"\n");
+        let a = run(&format!("rotation-ball-still-{contact}"), &on_table(4.0, 8, &sphere, 0.25));
+        let b = run(&format!("rotation-ball-turning-{contact}"), &on_table(4.0, 8, &format!("{sphere}rotation = [[1.0, 40.0]]\naxis = [1.0, 1.0, 0.3]\n"), 0.25));
+        let d = history_difference(&a, &b);
+        println!("force-driven sphere turning about its centre, {contact} contact: history.csv differs by {d:e}");
+        assert!(d < 1e-9, "{contact}: history.csv differs by {d:e}");
+    }
 }
 
 #[test]
@@ -164,6 +167,8 @@ fn bad_rotations_are_refused_with_the_key() {
         (format!("{cylinder}rotation = [[0.0, 1.0]]\n"), "rotation row 0: at t = 0 the angle must be 0"),
         (format!("{cylinder}rotation = [[0.5, 1.0, 2.0]]\n"), "rotation row 0: expected [t, angle], got 3 numbers"),
         (format!("{cylinder}rotation = 30.0\n"), "expected rows [[t, angle], ...]"),
+        // a die that only turns, tilting down onto nodes the table holds: the check sees the turned surface
+        ("shape = \"plane\"\npoint = [0.0, 0.0, 0.6]\nnormal = [0.0, 0.0, -1.0]\nrotation = [[1.0, 10.0]]\naxis = [0.0, 1.0, 0.0]\npivot = [0.0, 0.0, 0.6]\n".to_string(), "at load factor 1 its surface lies"),
     ] {
         let file = write(&dir, "p.toml", &on_table(2.0, 4, &punch, 0.5));
         let o = Command::new(env!("CARGO_BIN_EXE_stamp")).arg("check").arg(&file).output().unwrap();

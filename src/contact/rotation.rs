@@ -50,7 +50,7 @@ impl PunchRotation {
             if k == 0 && t == 0.0 && angle != 0.0 {
                 return Err("row 0: at t = 0 the angle must be 0 (turn the punch by its geometry; the rotation starts there)".into());
             }
-            if k > 0 && !(t > rows[k - 1].0) {
+            if k > 0 && t <= rows[k - 1].0 {
                 return Err(format!("row {k}: the load factors must increase strictly, but t = {t} follows t = {}", rows[k - 1].0));
             }
         }
