@@ -1,11 +1,12 @@
 //! With Coulomb friction the assembled tangent of a model (plate plus a curved punch) is still the
 //! derivative of its residual: compared with central finite differences at a random
 //! large-displacement state where some points stick and some slip, with the punch moved by a
-//! prescribed displacement or pressed by a force (its travel an unknown).
+//! prescribed displacement or pressed by a force (its travel an unknown), and turned by a
+//! prescribed rotation (friction then works in the punch's body frame).
 
 mod common;
 use common::*;
-use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive, SLIP, STICK};
+use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive, PunchRotation, SLIP, STICK};
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
@@ -31,6 +32,11 @@ fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
 /// stick, some slip) and a random tangential multiplier. Returns the model, evaluated once with
 /// the tangent there, and the state.
 fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>) -> (Model<PlateElements>, Vec<f64>) {
+    model_turned_at(surface, seed, mu, drive, None)
+}
+
+/// [`model_at`] with the punch turned by `rotation` too.
+fn model_turned_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>, rotation: Option<PunchRotation>) -> (Model<PlateElements>, Vec<f64>) {
     let mut mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 3, 3).unwrap();
     let mut rng = Lcg(seed);
     for n in 0..mesh.num_nodes() {
@@ -56,6 +62,7 @@ fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64
     if let Some(n) = drive {
         pair.drive = Some(ForceDrive::new(n, 7.0).unwrap());
     }
+    pair.rotation = rotation;
     pair.set_friction(mu).unwrap();
     model.add_contact(pair);
     let mut u: Vec<f64> = (0..model.num_dofs()).map(|_| rng.range(-0.3, 0.3)).collect();
@@ -119,7 +126,26 @@ fn fd_error(model: &mut Model<PlateElements>, u: &[f64]) -> (f64, usize) {
 }
 
 fn check(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>) -> f64 {
-    let (mut model, u) = model_at(surface, seed, 0.3, drive);
+    check_turned(surface, seed, drive, None)
+}
+
+fn check_turned(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>, rotation: Option<PunchRotation>) -> f64 {
+    let (mut model, u) = model_turned_at(surface, seed, 0.3, drive, rotation);
+    check_model(&mut model, &u, seed)
+}
+
+/// The first seed from `seed` on (of 40) whose state has two points or more in stick and in slip.
+fn mixed_seed(surface: &Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>, rotation: &PunchRotation) -> u64 {
+    (seed..seed + 40)
+        .find(|&s| {
+            let (m, _) = model_turned_at(surface.clone(), s, 0.3, drive, Some(rotation.clone()));
+            let f = m.contacts[0].friction.as_ref().unwrap();
+            f.status.iter().filter(|&&x| x == STICK).count() >= 2 && f.status.iter().filter(|&&x| x == SLIP).count() >= 2
+        })
+        .expect("a state with points in stick and in slip")
+}
+
+fn check_model(model: &mut Model<PlateElements>, u: &[f64], seed: u64) -> f64 {
     let f = model.contacts[0].friction.as_ref().unwrap();
     let stick = f.status.iter().filter(|&&s| s == STICK).count();
     let slip = f.status.iter().filter(|&&s| s == SLIP).count();
@@ -128,7 +154,7 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Opt
     let k = dense(model.matrix());
     let asym = (0..k.len()).flat_map(|i| (0..k.len()).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max((k[i][j] - k[j][i]).abs()));
     assert!(asym > 0.0);
-    let (worst, skipped) = fd_error(&mut model, &u);
+    let (worst, skipped) = fd_error(model, u);
     println!("seed {seed}: {stick} stick, {slip} slip, tangent vs differences {worst:e} ({skipped} columns skipped)");
     assert!(skipped < k.len() / 4, "{skipped} columns crossed a kink");
     assert!(worst < 1e-6, "model tangent with friction differs from finite differences by {worst:e}");
@@ -147,6 +173,24 @@ fn friction_tangent_with_a_force_driven_punch_matches_finite_differences() {
     check(Arc::new(s), 21, Some([0.3, -0.2, -1.0]));
     let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
     check(Arc::new(c), 22, Some([0.0, 0.0, -1.0]));
+}
+
+/// A punch turned at the load factor of the state (25 degrees about a tilted axis through a
+/// pivot off the sphere's centre; a cylinder about its own axis, force driven): the friction's
+/// law in the body frame, turned back to global axes, is still the derivative of the residual.
+#[test]
+fn friction_tangent_with_a_turning_punch_matches_finite_differences() {
+    let s: Arc<dyn stamp::surface::ContactSurface> = Arc::new(Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap());
+    let r = PunchRotation::new([0.2, 1.0, 0.3], [1.2, 0.9, 1.0], &[(0.5, 10.0), (1.0, 25.0)]).unwrap();
+    for (seed, drive) in [(11, None), (21, Some([0.3, -0.2, -1.0]))] {
+        let seed = mixed_seed(&s, seed, drive, &r);
+        check_turned(s.clone(), seed, drive, Some(r.clone()));
+    }
+    let axis = [1.0, 0.3, 0.0];
+    let c: Arc<dyn stamp::surface::ContactSurface> = Arc::new(Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::from(axis), 1.3).unwrap());
+    let r = PunchRotation::new(axis, [0.0, 1.0, 1.0], &[(1.0, -40.0)]).unwrap();
+    let seed = mixed_seed(&c, 22, Some([0.0, 0.0, -1.0]), &r);
+    check_turned(c, seed, Some([0.0, 0.0, -1.0]), Some(r));
 }
 
 /// mu = 0 is no friction at all: no friction state (so no friction code runs; the bitwise

@@ -6,7 +6,8 @@
 use super::first_touch::{ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 use super::kinematics::{Kinematics, SurfaceAtPoint};
 use super::friction_law::Friction;
-use super::{ContactFace, ForceDrive, PointShare, PunchMotion};
+use super::rotation::Turn;
+use super::{ContactFace, ForceDrive, PointShare, PunchMotion, PunchRotation, Turned};
 use crate::surface::ContactSurface;
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -189,6 +190,11 @@ pub struct ContactPair {
     pub(super) share: Option<PointShare>,
     /// Coulomb friction ([`set_friction`](Self::set_friction)); None: frictionless.
     pub friction: Option<Friction>,
+    /// The punch's prescribed rotation about a pivot that travels with its translation
+    /// (docs/design.md, "Punches that turn"); None: it only translates.
+    pub rotation: Option<PunchRotation>,
+    /// The rotation at the last evaluation's load factor (None: not turned).
+    pub(super) turn: Option<Turn>,
 }
 
 impl ContactPair {
@@ -239,6 +245,8 @@ impl ContactPair {
             last_trial: vec![0.0; n],
             share: None,
             friction: None,
+            rotation: None,
+            turn: None,
         }
     }
 
@@ -316,6 +324,18 @@ impl ContactPair {
         Ok(())
     }
 
+    /// The punch's surface at load factor `t` in the translated frame (positions x - d, d the
+    /// punch displacement): turned by its rotation at t, if it has one. Psi, the gradient and the
+    /// Hessian the constraint uses; the checks and outputs query the punch through it.
+    pub fn surface_at(&self, t: f64) -> Turned<'_> {
+        Turned { surface: &*self.surface, turn: self.rotation.as_ref().and_then(|r| r.turn(t)) }
+    }
+
+    /// The punch's surface as turned at the last evaluation.
+    pub(super) fn placed(&self) -> Turned<'_> {
+        Turned { surface: &*self.surface, turn: self.turn }
+    }
+
     /// The punch displacement at load factor `t` for the unknowns `u`: the prescribed motion at t,
     /// plus s * direction when force-driven.
     pub fn punch_displacement(&self, u: &[f64], t: f64) -> [f64; 3] {
@@ -370,7 +390,14 @@ impl ContactPair {
         let violation = gaps.max(self.penetration_where(|k| self.owns(k)));
         match &self.friction {
             None => violation,
-            Some(f) => violation.max(f.stick_violation(|k| Vector3::from(self.state[k].grad).normalize(), |k| self.owns(k))),
+            Some(f) => {
+                // the anchors are in the punch's body frame: so is the normal
+                let normal = |k: usize| {
+                    let n = Vector3::from(self.state[k].grad).normalize();
+                    self.turn.map_or(n, |t| t.r.tr_mul(&n))
+                };
+                violation.max(f.stick_violation(normal, |k| self.owns(k)))
+            }
         }
     }
 

@@ -2,6 +2,7 @@
 //! multiplier by the normal law, and its force and tangent by the pair's scheme; a force-driven
 //! punch's equation, and its hold on the plate while nothing touches.
 
+use crate::surface::ContactSurface;
 use super::integrated::integrated_kinematics;
 use super::kinematics::{point_displacement, SiteContext};
 use super::nodal::nodal_kinematics;
@@ -34,6 +35,7 @@ impl ContactPair {
         let own = |k: usize| share.is_none_or(|s| s.own[k]);
         let evaluated = |k: usize| share.is_none_or(|s| s.evaluated[k]);
         let d = Vector3::from(self.punch_displacement(u, t));
+        self.turn = self.rotation.as_ref().and_then(|r| r.turn(t));
         let drive = self.drive;
         let dn = drive.map(|f| Vector3::from(f.direction)).unwrap_or_else(Vector3::zeros);
         let mut changes = 0;
@@ -52,6 +54,7 @@ impl ContactPair {
         let mut sites = std::mem::take(&mut self.site_scratch);
         let site = SiteContext {
             surface: &*self.surface,
+            turn: self.turn,
             kinematics: self.kinematics,
             d,
             prescribed: Vector3::from(self.motion.displacement(t)),
@@ -194,7 +197,7 @@ impl ContactPair {
                 ContactKinematics::Exact => (-g.dot(dn), Some(Vector3::from(p.x_ref) + point_displacement(u, p) - d)),
                 ContactKinematics::Shallow { .. } => {
                     let x0 = Vector3::from(p.x_ref) - Vector3::from(self.motion.displacement(t));
-                    (-self.surface.gradient(&x0).dot(dn), None)
+                    (-self.placed().gradient(&x0).dot(dn), None)
                 }
             };
             self.state[k].lambda = lambda;

@@ -6,6 +6,7 @@
 //! that cycle: their changes counted per load step, frozen after too many. Also the paper's
 //! update of a fixed set between Newton solves (eqs. 4.14b, 4.15a).
 
+use crate::surface::ContactSurface;
 use super::kinematics::Kinematics;
 use super::normal_law::trial_multiplier;
 use super::{ContactPair, PointShare};
@@ -316,6 +317,6 @@ impl ContactPair {
             && active
             && !was_active
             && lambda < 0.0
-            && hess_at.is_some_and(|x| self.converged_scale == 0.0 || psi.abs() * self.surface.hessian(x).norm() > DEEP_ENTRY_RATIO * grad.norm_squared())
+            && hess_at.is_some_and(|x| self.converged_scale == 0.0 || psi.abs() * self.placed().hessian(x).norm() > DEEP_ENTRY_RATIO * grad.norm_squared())
     }
 }

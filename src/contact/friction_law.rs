@@ -1,9 +1,10 @@
 //! Coulomb friction of one nodal contact point (docs/design.md, "Friction"): an augmented
 //! Lagrangian with a return map (Simo & Laursen 1992, Alart & Curnier 1991).
 //!
-//! Each point has a stick anchor a, the punch's material point it sticks to, in the punch's frame
-//! (positions x - d, d the punch's translation), and an augmented tangential multiplier
-//! lambda_T_bar. At an evaluation, with x the point's position in the punch's frame,
+//! Each point has a stick anchor a, the punch's material point it sticks to, in the punch's body
+//! frame (positions R^T (x - d - pivot) + pivot, d the punch's translation, R its rotation: x - d
+//! for a punch that does not turn), and an augmented tangential multiplier lambda_T_bar in the
+//! same frame. At an evaluation, with x the point's position in the punch's body frame,
 //! n = grad Psi / |grad Psi| and P = I - n n^T:
 //!
 //! - the trial traction t_tr = P (lambda_T_bar + eps_T (x - a)),
@@ -16,7 +17,9 @@
 //! t with the anchor kept, so that at convergence of the updates a sticking point does not move
 //! against the punch at all; a converged step moves the anchor of a slipping point by its slip,
 //! a <- x - (t - lambda_T_bar) / eps_T (the return map: the next trial at the same place is t),
-//! and sets an open point's anchor where it is.
+//! and sets an open point's anchor where it is. The law is evaluated in the body frame, with
+//! Psi0's gradient and Hessian there, and its traction and tangent turned to global axes by R: a
+//! point sticking to a punch that turns is carried with it, and makes no slip.
 
 use super::stick_slip::StickSlip;
 use super::ContactPair;
@@ -24,7 +27,8 @@ use nalgebra::{Matrix3, Vector3};
 
 impl ContactPair {
     /// The friction of point k at an evaluation (the pair has friction): its return map at its
-    /// position `x` in the punch's frame (where the Hessian is taken), its force w t on the
+    /// position `x` in the translated frame (where the Hessian is taken; taken to the body frame
+    /// here when the punch has turned), its force w t on the
     /// point's displacement and -w t . n on a force-driven punch's equation (direction `dn`: the
     /// point's position in the punch's frame moves by -dn with the punch's travel), and with
     /// `with_tangent` its tangent entries into the friction's list (the model adds them). The
@@ -34,9 +38,17 @@ impl ContactPair {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn add_friction(&mut self, k: usize, lambda: f64, active: bool, grad: &Vector3<f64>, x: Option<&Vector3<f64>>, dn: &Vector3<f64>, force: &mut [f64], with_tangent: bool) -> bool {
         let (p, eps_reg, drive) = (self.points[k], self.eps_reg, self.drive);
-        let Some(x) = x.copied() else { return false };
+        let Some(y) = x.copied() else { return false };
+        let turn = self.turn;
+        // the body frame (the translated one when the punch has not turned)
+        let (x, grad) = match &turn {
+            None => (y, *grad),
+            Some(t) => (t.to_body(&y), t.r.tr_mul(grad)),
+        };
+        let grad = &grad;
         let hess = if active { Some(self.surface.hessian(&x)) } else { None };
         let Some(f) = &mut self.friction else { return false };
+        f.turn = turn.map(|t| t.r);
         f.position[k] = x.into();
         let Some(hess) = hess else {
             f.traction[k] = [0.0; 3];
@@ -46,10 +58,15 @@ impl ContactPair {
         };
         let (a, lt) = (Vector3::from(f.anchor[k]), Vector3::from(f.lambda_t_bar[k]));
         let natural = return_map(f.mu, f.eps_t, &x, &a, &lt, lambda, &(grad * eps_reg), grad, &hess);
-        // the branch the stick/slip criterion holds this point on (stick_slip.rs)
+        // the branch the stick/slip criterion holds this point on (stick_slip.rs), decided in the
+        // body frame
         let branch = f.laws.branch(k, &natural, with_tangent);
-        let pf = if branch == natural.status { natural } else { return_map_on(Some(branch), f.mu, f.eps_t, &x, &a, &lt, lambda, &(grad * eps_reg), grad, &hess) };
         let inconsistent = with_tangent && f.laws.inconsistent(k, &natural);
+        let pf = if branch == natural.status { natural } else { return_map_on(Some(branch), f.mu, f.eps_t, &x, &a, &lt, lambda, &(grad * eps_reg), grad, &hess) };
+        let pf = match &turn {
+            None => pf,
+            Some(t) => pf.turned(&t.r),
+        };
         f.traction[k] = pf.traction.into();
         f.status[k] = pf.status;
         let w = p.weight;
@@ -112,13 +129,16 @@ pub struct Friction {
     pub eps_t: f64,
     /// The augmented tangential multipliers lambda_T_bar.
     pub lambda_t_bar: Vec<[f64; 3]>,
-    /// The stick anchors, in the punch's frame (x - d).
+    /// The stick anchors, in the punch's body frame (x - d when it does not turn).
     pub anchor: Vec<[f64; 3]>,
-    /// Each point's position in the punch's frame at the last evaluation.
+    /// Each point's position in the punch's body frame at the last evaluation.
     pub position: Vec<[f64; 3]>,
     /// Each point's tangential traction t at the last evaluation (force per unit reference area of
-    /// the plate on the punch).
+    /// the plate on the punch), in global axes.
     pub traction: Vec<[f64; 3]>,
+    /// The punch's rotation R at the last evaluation (None: not turned, the frames agree): the
+    /// multipliers, anchors and positions are in its body frame, the traction in global axes.
+    pub turn: Option<Matrix3<f64>>,
     /// [`OPEN`], [`STICK`] or [`SLIP`] at the last evaluation.
     pub status: Vec<u8>,
     /// The accumulated slip length of each point over the converged steps.
@@ -144,6 +164,7 @@ impl Friction {
             anchor: position.clone(),
             position,
             traction: vec![[0.0; 3]; n],
+            turn: None,
             status: vec![OPEN; n],
             slip: vec![0.0; n],
             dissipation: vec![0.0; n],
@@ -157,7 +178,7 @@ impl Friction {
     pub fn augment(&mut self, evaluated: impl Fn(usize) -> bool) {
         for k in 0..self.status.len() {
             if evaluated(k) {
-                self.lambda_t_bar[k] = if self.status[k] == OPEN { [0.0; 3] } else { self.traction[k] };
+                self.lambda_t_bar[k] = if self.status[k] == OPEN { [0.0; 3] } else { self.body_traction(k).into() };
             }
         }
     }
@@ -175,6 +196,12 @@ impl Friction {
             .fold(0.0, f64::max)
     }
 
+    /// Point k's traction in the punch's body frame, R^T t.
+    fn body_traction(&self, k: usize) -> Vector3<f64> {
+        let t = Vector3::from(self.traction[k]);
+        self.turn.map_or(t, |r| r.tr_mul(&t))
+    }
+
     /// A converged step: a slipping point's anchor follows its slip (return map), adding the slip's
     /// length and w t . slip to its totals; an open point's anchor is where it is, its multiplier
     /// zero; a sticking point keeps both.
@@ -182,7 +209,7 @@ impl Friction {
         for k in 0..self.status.len() {
             match self.status[k] {
                 SLIP => {
-                    let t = Vector3::from(self.traction[k]);
+                    let t = self.body_traction(k);
                     let a_new = Vector3::from(self.position[k]) - (t - Vector3::from(self.lambda_t_bar[k])) / self.eps_t;
                     let ds = a_new - Vector3::from(self.anchor[k]);
                     self.slip[k] += ds.norm();
@@ -214,6 +241,15 @@ pub struct PointFriction {
     /// Its size against the bound: |trial| / (mu q) (infinite without pressure).
     pub cone_ratio: f64,
     pub status: u8,
+}
+
+impl PointFriction {
+    /// The law of a point evaluated in a body frame, in global axes: the traction R t, the
+    /// tangent R (dt/dX) R^T (X = R^T y + const).
+    pub fn turned(self, r: &Matrix3<f64>) -> PointFriction {
+        let rt = r.transpose();
+        PointFriction { traction: r * self.traction, jacobian: r * self.jacobian * rt, symmetric: r * self.symmetric * rt, trial: r * self.trial, cone_ratio: self.cone_ratio, status: self.status }
+    }
 }
 
 /// The return map of one point: `x` its position in the punch's frame, `a` its anchor,

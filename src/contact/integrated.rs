@@ -3,6 +3,7 @@
 //! tangent of the multiplier field lambda_h = sum_a N_a lambda_a, the pressures of that field; the
 //! points whose patches the model's sparse pattern couples.
 
+use crate::surface::ContactSurface;
 use super::face::FacePoint;
 use super::kinematics::{point_displacement, Kinematics, SiteContext, SurfaceAtPoint};
 use super::{ContactFace, ContactPair, ContactPoint, PointShare};
@@ -156,7 +157,7 @@ impl ContactPair {
                 force[f.dof] += part * wl * grad_s;
             }
             let (Some(add), Some(x)) = (add_tangent.as_deref_mut(), hess_at) else { continue };
-            let h = self.surface.hessian(x) * wl;
+            let h = self.placed().hessian(x) * wl;
             let hn = h * dn;
             for a in 0..4 {
                 if !own(q.points[a]) {

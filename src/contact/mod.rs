@@ -34,7 +34,9 @@
 //! `recover.rs` the recovered pressure field written beside the nodal one; `friction_law.rs`
 //! Coulomb friction of a nodal point (its return map, its tangent, its history; docs/design.md,
 //! "Friction"); `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
-//! `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves; `share.rs` the points
+//! `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves; `rotation.rs` how it
+//! turns, and `turned.rs` its surface as the rotation places it (Psi, gradient and Hessian, for
+//! every shape); `share.rs` the points
 //! of one process.
 
 mod constraint;
@@ -50,13 +52,17 @@ mod nodal;
 mod normal_law;
 mod recover;
 mod regularisation;
+mod rotation;
 mod share;
+mod turned;
 pub use constraint::{ContactKinematics, ContactPair, ContactPoint, PointState};
 pub use face::ContactFace;
 pub use friction_law::{return_map, return_map_on, Friction, PointFriction, OPEN, SLIP, STICK};
 pub use first_touch::{CONVERGING_TENSION, DEEP_ENTRY_RATIO, ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 pub use motion::{ForceDrive, PunchMotion};
 pub use recover::{recovered_pressure, RecoveredPressure, Recovery, RECOVERY};
+pub use rotation::{PunchRotation, Turn};
+pub use turned::Turned;
 pub use regularisation::{automatic_eps_reg, AUTO_EPS_FACTOR};
 pub use share::PointShare;
 

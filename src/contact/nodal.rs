@@ -33,7 +33,7 @@ impl ContactPair {
             force[f.dof] += w * lambda * grad_s;
         }
         if let Some(add) = add_tangent.as_deref_mut() {
-            point_tangent(&*self.surface, p, self.drive.as_ref(), dn, grad, grad_s, hess_at, w * self.eps_reg, w * curvature, add);
+            point_tangent(&self.placed(), p, self.drive.as_ref(), dn, grad, grad_s, hess_at, w * self.eps_reg, w * curvature, add);
         }
     }
 

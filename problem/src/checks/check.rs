@@ -35,6 +35,7 @@ use crate::model::build::Setup;
 use crate::model::mesh::{where_node, MeshData};
 use crate::schema::{LoadFace, LoadKind, PlotAxis, Problem};
 use nalgebra::Vector3;
+use stamp::surface::ContactSurface;
 use stamp::dofs::PRESCRIBED;
 use stamp::nonlinear::NonlinearProblem;
 use stamp::{quote, Result, StampError};
@@ -142,7 +143,7 @@ pub const SUPPORTED_THINNING: f64 = 0.1;
 /// Refused with the first such node, how deep the punch reaches there and at what load factor.
 fn check_supported_nodes_under(p: &Problem, setup: &Setup, i: usize) -> Result<()> {
     let pair = &setup.model.contacts[i];
-    if pair.drive.is_some() || pair.motion.is_zero() {
+    if pair.drive.is_some() || (pair.motion.is_zero() && pair.rotation.is_none()) {
         return Ok(());
     }
     let dofs = &setup.model.dofs;
@@ -155,14 +156,20 @@ fn check_supported_nodes_under(p: &Problem, setup: &Setup, i: usize) -> Result<(
         let end = setup.targets.iter().cloned().fold(0.0, f64::max);
         samples.extend(rows.iter().map(|r| r.0).filter(|&t| t <= end));
     }
+    // and those where a turning punch turns differently (its surface as turned there)
+    if let Some(r) = &pair.rotation {
+        let end = setup.targets.iter().cloned().fold(0.0, f64::max);
+        samples.extend(r.rows().iter().map(|r| r.0).filter(|&t| t <= end));
+    }
     for &t in &samples {
         let d = pair.motion.displacement(t);
-        if d == [0.0; 3] {
+        let surface = pair.surface_at(t);
+        if d == [0.0; 3] && surface.turn.is_none() {
             continue;
         }
         for q in &pair.points {
             let x = Vector3::from(q.x_ref) - Vector3::from(d);
-            let (psi, g) = pair.surface.psi_and_gradient(&x);
+            let (psi, g) = surface.psi_and_gradient(&x);
             let gn = g.norm();
             if !(gn > 0.0 && psi.is_finite() && psi < 0.0) {
                 continue;
@@ -742,10 +749,14 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
         let _ = writeln!(o, "punches:");
     }
     for (i, ((info, pair), st)) in setup.punches.iter().zip(&setup.model.contacts).zip(starts).enumerate() {
-        let drive = match &pair.drive {
+        let mut drive = match &pair.drive {
             Some(f) => format!("driven by force {} along {}", num(f.force), vec3(f.direction)),
             None => format!("driven by {}", motion_words(&pair.motion)),
         };
+        if let Some(r) = &pair.rotation {
+            let (t, last) = r.rows().last().copied().unwrap_or((0.0, 0.0));
+            let _ = write!(drive, ", turning about {} through {} ({} degrees from t = {})", vec3(r.axis()), vec3(r.pivot()), num(last), num(t));
+        }
         let gap = match &st.first {
             Some(f) => format!(
                 "first gap {} at {}{}",

@@ -25,7 +25,8 @@ use crate::model::mesh::where_node;
 use crate::model::plate_model::Layout;
 use crate::schema::{Problem, Shape};
 use nalgebra::Vector3;
-use stamp::contact::{ContactPair, PunchMotion};
+use stamp::contact::{ContactPair, PunchMotion, PunchRotation};
+use stamp::surface::ContactSurface;
 use stamp::{quote, Result, StampError};
 use stamp_elements::Face;
 
@@ -75,11 +76,14 @@ pub fn gradient_problem(psi: f64, g: &Vector3<f64>, size: f64) -> Option<String>
 /// The load factors at which the start check samples the motion: 0, the targets, the path's rows
 /// up to the largest target and points between them, at most `most` (and [`MOTION_SAMPLES`]) and
 /// the last.
-fn motion_samples(motion: &PunchMotion, targets: &[f64], most: usize) -> Vec<f64> {
+fn motion_samples(motion: &PunchMotion, rotation: Option<&PunchRotation>, targets: &[f64], most: usize) -> Vec<f64> {
     let end = targets.iter().cloned().fold(0.0, f64::max);
     let mut t: Vec<f64> = std::iter::once(0.0).chain(targets.iter().copied()).collect();
     if let PunchMotion::Path(rows) = motion {
         t.extend(rows.iter().map(|r| r.0).filter(|&r| r <= end));
+    }
+    if let Some(r) = rotation {
+        t.extend(r.rows().iter().map(|r| r.0).filter(|&r| r <= end));
     }
     t.sort_by(f64::total_cmp);
     t.dedup();
@@ -108,15 +112,16 @@ pub fn check_expression(p: &Problem, setup: &Setup, i: usize, size: f64) -> Resu
     let pair = &setup.model.contacts[i];
     // (about 2 million evaluations at most: a few seconds on the largest meshes)
     let most = 2_000_000 / pair.points.len().max(1);
-    let samples = if pair.drive.is_some() { vec![0.0] } else { motion_samples(&pair.motion, &setup.targets, most) };
+    let samples = if pair.drive.is_some() { vec![0.0] } else { motion_samples(&pair.motion, pair.rotation.as_ref(), &setup.targets, most) };
     let mut usable = false;
     let mut covered_without: Option<(usize, f64, String)> = None;
     let mut first_problem: Option<String> = None;
     for &t in &samples {
         let d = Vector3::from(pair.motion.displacement(t));
+        let surface = pair.surface_at(t);
         for q in &pair.points {
             let x = Vector3::from(q.x_ref) - d;
-            let (psi, g) = pair.surface.psi_and_gradient(&x);
+            let (psi, g) = surface.psi_and_gradient(&x);
             match gradient_problem(psi, &g, size) {
                 None => usable = true,
                 Some(what) => {
@@ -157,7 +162,7 @@ pub fn check_expression(p: &Problem, setup: &Setup, i: usize, size: f64) -> Resu
 /// towards each target), which the run would then refuse after that step.
 pub fn sweep_warning(p: &Problem, setup: &Setup, i: usize) -> Option<String> {
     let c = &setup.model.contacts[i];
-    if c.drive.is_some() || c.motion.is_zero() {
+    if c.drive.is_some() || (c.motion.is_zero() && c.rotation.is_none()) {
         return None;
     }
     let layout = Layout::of(&setup.model.element);
@@ -203,7 +208,7 @@ pub fn after_step(p: &Problem, mesh: &MeshData, contacts: &[ContactPair], layout
                 ),
             });
         }
-        if c.drive.is_some() || c.motion.is_zero() {
+        if c.drive.is_some() || (c.motion.is_zero() && c.rotation.is_none()) {
             continue;
         }
         if let Some(e) = swept_through(p, mesh, c, i, layout, step, (t0, u0), (t1, u1)) {
@@ -218,10 +223,16 @@ pub fn after_step(p: &Problem, mesh: &MeshData, contacts: &[ContactPair], layout
 #[allow(clippy::too_many_arguments)]
 fn swept_through(p: &Problem, mesh: &MeshData, c: &ContactPair, i: usize, layout: &Layout, step: usize, (t0, u0): (f64, &[f64]), (t1, u1): (f64, &[f64])) -> Option<StampError> {
     let (lo, hi) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
-    let rows: Vec<(usize, f64)> = match &c.motion {
+    let mut rows: Vec<(usize, f64)> = match &c.motion {
         PunchMotion::Path(points) => points.iter().enumerate().filter(|(_, r)| r.0 > lo && r.0 < hi).map(|(k, r)| (k, r.0)).collect(),
         PunchMotion::Linear(_) => Vec::new(),
     };
+    // a rotation's rows are where the punch turns differently too
+    if let Some(r) = &c.rotation {
+        rows.extend(r.rows().iter().enumerate().filter(|(_, r)| r.0 > lo && r.0 < hi).map(|(k, r)| (k, r.0)));
+        rows.sort_by(|a, b| a.1.total_cmp(&b.1));
+        rows.dedup_by(|a, b| a.1 == b.1);
+    }
     let mut samples: Vec<f64> = (1..SWEEP_SAMPLES).map(|k| lo + (hi - lo) * k as f64 / SWEEP_SAMPLES as f64).chain(rows.iter().map(|r| r.1)).collect();
     samples.sort_by(f64::total_cmp);
     // the face offsets: a point's far face is the other one than its contact face (x_ref's x3)
@@ -237,7 +248,7 @@ fn swept_through(p: &Problem, mesh: &MeshData, c: &ContactPair, i: usize, layout
             let other = if top { Face::Bottom } else { Face::Top };
             let z = if top { dm } else { dp };
             let x = Vector3::new(q.x_ref[0] + u(layout.face_dof(other, q.node, 0)), q.x_ref[1] + u(layout.face_dof(other, q.node, 1)), z + u(layout.face_dof(other, q.node, 2)));
-            let (psi, g) = c.surface.psi_and_gradient(&(x - d));
+            let (psi, g) = c.surface_at(t).psi_and_gradient(&(x - d));
             let gn = robust_norm(&g);
             (psi < 0.0 && gn > 0.0 && psi / gn < -1e-9 * (dp - dm)).then_some(q.node)
         })
@@ -246,7 +257,13 @@ fn swept_through(p: &Problem, mesh: &MeshData, c: &ContactPair, i: usize, layout
     // (its penetration at a converged end is far below that): shorter motions need no samples
     let mut knots: Vec<f64> = std::iter::once(lo).chain(rows.iter().map(|r| r.1)).chain(std::iter::once(hi)).collect();
     knots.dedup();
-    let travel: f64 = knots.windows(2).map(|w| Vector3::from(c.motion.displacement(w[1])).metric_distance(&Vector3::from(c.motion.displacement(w[0])))).sum();
+    let mut travel: f64 = knots.windows(2).map(|w| Vector3::from(c.motion.displacement(w[1])).metric_distance(&Vector3::from(c.motion.displacement(w[0])))).sum();
+    if let Some(r) = &c.rotation {
+        // the arc a candidate point's place on the punch sweeps as the punch turns
+        let pivot = Vector3::from(r.pivot());
+        let reach = c.points.iter().map(|q| Vector3::from(q.x_ref).metric_distance(&pivot)).fold(0.0, f64::max);
+        travel += knots.windows(2).map(|w| (r.angle(w[1]) - r.angle(w[0])).abs().to_radians() * reach).sum::<f64>();
+    }
     if travel < 0.5 * (dp - dm) {
         return None;
     }
@@ -314,13 +331,13 @@ mod tests {
     #[test]
     fn motion_samples_hold_the_targets_and_the_path_rows() {
         let path = PunchMotion::path(&[(0.3, [0.0, 0.0, -1.0]), (0.7, [0.0, 0.0, 0.0]), (2.0, [0.0, 0.0, -5.0])]).unwrap();
-        let t = motion_samples(&path, &[0.5, 1.0], MOTION_SAMPLES);
+        let t = motion_samples(&path, None, &[0.5, 1.0], MOTION_SAMPLES);
         for want in [0.0, 0.3, 0.5, 0.7, 1.0] {
             assert!(t.contains(&want), "{want} not in {t:?}");
         }
         assert!(t.iter().all(|&x| x <= 1.0), "{t:?}");
         let many: Vec<f64> = (1..=1000).map(|k| k as f64 / 1000.0).collect();
-        let t = motion_samples(&PunchMotion::Linear([0.0, 0.0, -1.0]), &many, MOTION_SAMPLES);
+        let t = motion_samples(&PunchMotion::Linear([0.0, 0.0, -1.0]), None, &many, MOTION_SAMPLES);
         assert!(t.len() <= MOTION_SAMPLES + 1 && t[0] == 0.0 && *t.last().unwrap() == 1.0, "{}", t.len());
     }
 

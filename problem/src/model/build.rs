@@ -39,7 +39,7 @@ use crate::model::plate_model::{Layout, Plate};
 use crate::outputs::supports::Supports;
 use crate::schema::{ContactKinematicsSpec, ContactSpec, KinematicsSpec, LoadFace, LoadKind, Predictor, Problem, PunchFace, Shape, DEFAULT_MAX_INCREMENT};
 use nalgebra::Vector3;
-use stamp::contact::{automatic_eps_reg, ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive};
+use stamp::contact::{automatic_eps_reg, ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive, PunchRotation};
 use stamp::dofs::DofMap;
 use stamp::model::Model;
 use stamp::nonlinear::NewtonSettings;
@@ -533,6 +533,18 @@ fn build_punches(p: &Problem, mesh: &MeshData, section: &Section, young: f64, ki
         };
         pair.eps_reg = eps_reg;
         pair.motion = spec.motion.as_ref().map(|m| m.0.clone()).unwrap_or_default();
+        if let Some(r) = &spec.rotation {
+            // a cylinder turns about its own axis through its point unless told otherwise, a
+            // sphere about its centre
+            let axis = match spec.shape {
+                Shape::Cylinder => spec.rotation_axis.or(spec.axis),
+                _ => spec.axis,
+            };
+            let pivot = spec.pivot.or(spec.point.filter(|_| spec.shape == Shape::Cylinder)).or(spec.center);
+            // (check_rotation_keys refused a rotation without them)
+            let (axis, pivot) = (axis.map_or([0.0; 3], |a| a.0), pivot.map_or([f64::NAN; 3], |v| v.0));
+            pair.rotation = Some(PunchRotation::new(axis, pivot, &r.get_ref().0).map_err(|e| p.error_at(r.span(), &format!("{key}.rotation"), e))?);
+        }
         // an expression must be finite (and smooth) at every candidate point where the punch starts
         if let Some(psi) = &spec.psi {
             for q in &pair.points {

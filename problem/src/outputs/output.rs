@@ -26,6 +26,7 @@ use crate::model::build::PunchInfo;
 use crate::model::mesh::MeshData;
 use crate::model::plate_model::{Layout, Plate};
 use nalgebra::Vector3;
+use stamp::surface::ContactSurface;
 use serde::Serialize;
 use stamp::element::Element;
 use stamp::io::Field;
@@ -333,15 +334,16 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         }
         // gap of the nodes that are not candidates: the exact gap of the touched face
         let shift = Vector3::from(pair.punch_displacement(u, t));
+        let surface = pair.surface_at(t);
         for node in 0..n {
             if candidate[node] {
                 continue;
             }
             let d = face_disp(u, node, info.face);
             let x = Vector3::new(coords[node][0] + d[0], coords[node][1] + d[1], info.z + d[2]) - shift;
-            let g = info.surface.gradient(&x).norm();
+            let g = surface.gradient(&x).norm();
             if g > 0.0 {
-                gap[node] = gap[node].min(info.surface.psi(&x) / g);
+                gap[node] = gap[node].min(surface.psi(&x) / g);
             }
         }
         let r = pair.reaction();

@@ -54,6 +54,34 @@ impl<'de> Deserialize<'de> for MotionSpec {
     }
 }
 
+/// A punch's prescribed rotation: rows `[[t, angle], ...]`, the angle in degrees piecewise linear
+/// in the load factor t (checked as a path's rows by [`stamp::contact::PunchRotation::new`]); its
+/// axis and pivot are other keys (`axis` or a cylinder's `rotation_axis`, `pivot`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RotationSpec(pub Vec<(f64, f64)>);
+impl<'de> Deserialize<'de> for RotationSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        const FORM: &str = "expected rows [[t, angle], ...] (the angle in degrees, piecewise linear in the load factor t)";
+        let rows = Vec::<Vec<f64>>::deserialize(d).map_err(|_| D::Error::custom(FORM))?;
+        if rows.len() > limits::MAX_PATH_ROWS {
+            return Err(D::Error::custom(format!("a rotation has at most {} rows, got {}", limits::MAX_PATH_ROWS, rows.len())));
+        }
+        let mut out = Vec::with_capacity(rows.len());
+        for (k, r) in rows.iter().enumerate() {
+            if r.len() != 2 {
+                return Err(D::Error::custom(format!("rotation row {k}: expected [t, angle], got {} numbers", r.len())));
+            }
+            if !r.iter().all(|x| x.is_finite() && x.abs() <= limits::MAX_MAGNITUDE) {
+                return Err(D::Error::custom(format!("rotation row {k}: expected finite numbers of magnitude at most 1e100, got {}", vec_text(r))));
+            }
+            out.push((r[0], r[1]));
+        }
+        // the rows' own checks (the axis and pivot come later)
+        stamp::contact::PunchRotation::new([0.0, 0.0, 1.0], [0.0; 3], &out).map_err(|e| D::Error::custom(format!("rotation {e}")))?;
+        Ok(RotationSpec(out))
+    }
+}
+
 /// A non-zero 3-vector (a direction).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Direction(pub [f64; 3]);
@@ -108,7 +136,8 @@ pub struct PunchSpec {
     /// cylinder: a point of the axis; plane: a point of the plane.
     #[serde(default)]
     pub point: Option<Vec3>,
-    /// cylinder: the axis direction.
+    /// cylinder: the axis direction (and the axis of its `rotation` unless `rotation_axis` is
+    /// given); other shapes: the axis of their `rotation`.
     #[serde(default)]
     pub axis: Option<Direction>,
     /// sphere: the centre.
@@ -160,6 +189,18 @@ pub struct PunchSpec {
     /// frictionless). Nodal contact with exact kinematics only.
     #[serde(default)]
     pub friction: Option<Spanned<FrictionCoefficient>>,
+    /// The punch's rotation: rows [t, angle in degrees] about `axis` (a cylinder: its own axis,
+    /// or `rotation_axis`) through `pivot`, a point of the punch that travels with its
+    /// translation (default: a cylinder's `point`, a sphere's `center`).
+    #[serde(default)]
+    pub rotation: Option<Spanned<RotationSpec>>,
+    /// The point the rotation turns the punch about, at t = 0.
+    #[serde(default)]
+    pub pivot: Option<Vec3>,
+    /// cylinder: the rotation's axis when it is not the cylinder's own (a roller that tilts or
+    /// steers).
+    #[serde(default)]
+    pub rotation_axis: Option<Direction>,
 }
 
 /// `[[punch]] contact`: the discretisation of the contact constraint.
@@ -185,23 +226,26 @@ impl Problem {
                     Err(self.error_at(p.span(), &key, what))
                 }
             };
+            // a shape without an axis of its own takes `axis` as its rotation's
+            let no_axis = ps.axis.is_none() || ps.rotation.is_some();
+            let axis_note = if ps.axis.is_some() { "; `axis` only as the axis of a `rotation`" } else { "" };
             match ps.shape {
                 Shape::Cylinder => need(
                     ps.point.is_some() && ps.axis.is_some() && ps.radius.is_some() && ps.center.is_none() && ps.normal.is_none(),
                     "a cylinder needs `point`, `axis` and `radius` (and no `center` or `normal`)",
                 )?,
                 Shape::Sphere => need(
-                    ps.center.is_some() && ps.radius.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.normal.is_none(),
-                    "a sphere needs `center` and `radius` (and no `point`, `axis` or `normal`)",
+                    ps.center.is_some() && ps.radius.is_some() && ps.point.is_none() && no_axis && ps.normal.is_none(),
+                    &format!("a sphere needs `center` and `radius` (and no `point`, `axis` or `normal`){axis_note}"),
                 )?,
                 Shape::Plane => need(
-                    ps.point.is_some() && ps.normal.is_some() && ps.radius.is_none() && ps.axis.is_none() && ps.center.is_none(),
-                    "a plane needs `point` and `normal` (and no `radius`, `axis` or `center`)",
+                    ps.point.is_some() && ps.normal.is_some() && ps.radius.is_none() && no_axis && ps.center.is_none(),
+                    &format!("a plane needs `point` and `normal` (and no `radius`, `axis` or `center`){axis_note}"),
                 )?,
                 Shape::Expression => {
                     need(
-                        ps.psi.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
-                        "an expression punch needs `psi` (and no `point`, `axis`, `center`, `radius` or `normal`)",
+                        ps.psi.is_some() && ps.point.is_none() && no_axis && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
+                        &format!("an expression punch needs `psi` (and no `point`, `axis`, `center`, `radius` or `normal`){axis_note}"),
                     )?;
                     let psi = ps.psi.as_ref().unwrap();
                     if let Err(e) = stamp_contact::expression_parser::parse(psi.get_ref()) {
@@ -209,10 +253,11 @@ impl Problem {
                     }
                 }
                 Shape::Stl => need(
-                    ps.file.is_some() && ps.point.is_none() && ps.axis.is_none() && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
-                    "an stl die needs `file` (and no `point`, `axis`, `center`, `radius` or `normal`: the die is where the file puts it)",
+                    ps.file.is_some() && ps.point.is_none() && no_axis && ps.center.is_none() && ps.radius.is_none() && ps.normal.is_none(),
+                    &format!("an stl die needs `file` (and no `point`, `axis`, `center`, `radius` or `normal`: the die is where the file puts it){axis_note}"),
                 )?,
             }
+            self.check_rotation_keys(i)?;
             if ps.shape != Shape::Expression && ps.psi.is_some() {
                 return Err(self.error_at(ps.psi.as_ref().unwrap().span(), &format!("{key}.psi"), "`psi` belongs to shape = \"expression\""));
             }
@@ -236,6 +281,45 @@ impl Problem {
             if !names.insert(name.clone()) {
                 return Err(self.error_at(p.span(), &format!("{key}.name"), format!("two punches are named '{}'", quote(&name))));
             }
+        }
+        Ok(())
+    }
+
+    /// The keys of a punch's rotation: `pivot` and `rotation_axis` need `rotation`; a shape
+    /// without an axis of its own needs `axis` (the rotation's) and, but for a sphere (about its
+    /// centre by default), `pivot`; `rotation_axis` is a cylinder's.
+    fn check_rotation_keys(&self, i: usize) -> Result<()> {
+        let p = &self.spec.punch[i];
+        let ps = p.get_ref();
+        let key = format!("punch[{i}]");
+        let err = |k: &str, what: String| Err(self.error_at(p.span(), &format!("{key}.{k}"), what));
+        let what = match ps.shape {
+            Shape::Cylinder => "cylinder",
+            Shape::Sphere => "sphere",
+            Shape::Plane => "plane",
+            Shape::Expression => "expression punch",
+            Shape::Stl => "stl die",
+        };
+        let Some(rotation) = &ps.rotation else {
+            if ps.pivot.is_some() {
+                return err("pivot", "`pivot` is the point a `rotation` turns the punch about; it needs `rotation` (rows [t, angle])".into());
+            }
+            if ps.rotation_axis.is_some() {
+                return err("rotation_axis", "`rotation_axis` is the axis of a cylinder's `rotation`; it needs `rotation` (rows [t, angle])".into());
+            }
+            return Ok(());
+        };
+        if ps.shape == Shape::Cylinder {
+            return Ok(());
+        }
+        if ps.rotation_axis.is_some() {
+            return err("rotation_axis", format!("`rotation_axis` is a cylinder's (whose `axis` is its own); a {what} gives the axis of its rotation as `axis`"));
+        }
+        if ps.axis.is_none() {
+            return Err(self.error_at(rotation.span(), &format!("{key}.axis"), format!("a {what} turned by `rotation` needs `axis` (the direction it turns about) and `pivot` (a point of the punch on that axis)")));
+        }
+        if ps.pivot.is_none() && ps.shape != Shape::Sphere {
+            return Err(self.error_at(rotation.span(), &format!("{key}.pivot"), format!("a {what} turned by `rotation` needs `pivot`, a point of the punch (at t = 0) on the rotation's axis")));
         }
         Ok(())
     }

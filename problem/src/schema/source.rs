@@ -22,7 +22,8 @@ pub(super) fn toml_message(source: &str, e: &toml::de::Error) -> String {
     // serde quotes user text (an unknown key, a bad string) in full: cut every long word at 80
     // characters, and the whole at 300
     let what: Vec<String> = e.message().trim().split(' ').map(|w| if w.chars().count() > QUOTE_LIMIT { quote(w) } else { w.to_string() }).collect();
-    let what = quote_long(&what.join(" "), 300);
+    let what = unquoted_key_list(&what.join(" "));
+    let what = quote_long(&what, 300);
     let Some(span) = e.span() else { return what };
     let (line, col) = line_col_of(source, span.start);
     // `E = 210 GPa`: toml asks for quotes, but the value is meant as a number
@@ -54,6 +55,17 @@ pub(super) fn toml_message(source: &str, e: &toml::de::Error) -> String {
         _ => what,
     };
     format!("line {line}, column {col}: {what}\n{}", source_window(source, line, col))
+}
+
+/// serde's "unknown field `x`, expected one of `a`, `b`, ..." with the table's keys listed without
+/// their backquotes: the list of a table of many keys (`[[punch]]`'s 22) stays whole within a
+/// message's length.
+fn unquoted_key_list(what: &str) -> String {
+    const LIST: &str = ", expected one of ";
+    match what.split_once(LIST) {
+        Some((head, keys)) if what.starts_with("unknown field") => format!("{head}{LIST}{}", keys.replace('`', "")),
+        _ => what.to_string(),
+    }
 }
 
 /// Known units as (name, kind in [units], factor to SI).
