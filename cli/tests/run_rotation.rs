@@ -65,7 +65,7 @@ fn history_difference(a: &Path, b: &Path) -> f64 {
     let (hb, rb) = history(b);
     assert_eq!(ha, hb);
     assert_eq!(ra.len(), rb.len(), "the same steps");
-    let family = |h: &str| if h.ends_with("_u1") || h.ends_with("_u2") || h.ends_with("_u3") || h.ends_with("_travel") { 1 } else if h.contains("_force") { 2 } else { 0 };
+    let family = |h: &str| if h.ends_with("_u1") || h.ends_with("_u2") || h.ends_with("_u3") || h.ends_with("_travel") { 1 } else if h.contains("_force") || h.contains("_reaction_x") { 2 } else { 0 };
     let largest = |f: usize| (0..ha.len()).filter(|&c| family(&ha[c]) == f).flat_map(|c| ra.iter().map(move |r| r[c].abs())).fold(0.0, f64::max);
     let mut worst = 0.0f64;
     for c in 0..ha.len() {

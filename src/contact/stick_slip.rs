@@ -63,35 +63,29 @@ impl StickSlip {
     }
 
     /// The branch point k is held on at this evaluation, `natural` its return map on the cone's
-    /// own branch. An evaluation with a tangent (a Newton iterate) records the branch; one
-    /// without (a line search's trial) only reads it.
+    /// own branch. An evaluation with a tangent (a Newton iterate) applies the rules and records
+    /// the branch; one without (a line search's trial, a finite difference) evaluates the branch
+    /// recorded, so that the tangent is the derivative of the residual it is used with.
     pub fn branch(&mut self, k: usize, natural: &PointFriction, with_tangent: bool) -> u8 {
+        if !with_tangent {
+            return match self.law[k] {
+                OPEN | FREE => natural.status,
+                law => law,
+            };
+        }
         let direction = natural.trial.try_normalize(0.0).unwrap_or_else(Vector3::zeros);
-        let mut law = self.law[k];
+        let law = self.law[k];
         if law == OPEN {
-            law = natural.status;
-            if with_tangent {
-                self.law[k] = law;
-                self.direction[k] = direction.into();
-            }
+            self.law[k] = natural.status;
+            self.direction[k] = direction.into();
         } else if law == STICK && natural.status == SLIP && natural.cone_ratio > CLEAR_SLIP {
-            law = SLIP;
-            if with_tangent {
-                self.switch(k, SLIP, direction);
-                law = if self.law[k] == FREE { natural.status } else { SLIP };
-            }
+            self.switch(k, SLIP, direction);
         } else if law == SLIP && (natural.trial.dot(&Vector3::from(self.direction[k])) < 0.0 || natural.cone_ratio < 1.0 / CLEAR_SLIP) {
-            law = STICK;
-            if with_tangent {
-                self.switch(k, STICK, Vector3::zeros());
-                law = if self.law[k] == FREE { natural.status } else { STICK };
-            }
+            self.switch(k, STICK, Vector3::zeros());
         }
-        if with_tangent {
-            self.natural[k] = natural.status;
-            self.natural_direction[k] = direction.into();
-        }
-        if law == FREE { natural.status } else { law }
+        self.natural[k] = natural.status;
+        self.natural_direction[k] = direction.into();
+        if self.law[k] == FREE { natural.status } else { self.law[k] }
     }
 
     /// Point k is held on a branch that is not the cone's (`natural`).
