@@ -298,11 +298,6 @@ impl<E: Element> Model<E> {
     /// entries: those of its own elements and the whole rows of its own nodes (every element
     /// around them), the rows and columns of the force-driven punches whole.
     pub fn set_share(&mut self, share: Option<Share>) -> Result<()> {
-        if share.is_some() {
-            if let Some(c) = self.contacts.iter().find(|c| c.friction.is_some()) {
-                return Err(StampError::Problem(format!("punch '{}': friction is not implemented in a distributed run (its state is not shared between the processes)", c.name)));
-            }
-        }
         let (ne, nn) = (self.element.num_elements(), self.dofs.num_nodes());
         self.assembler = match &share {
             Some(s) => {

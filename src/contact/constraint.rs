@@ -289,7 +289,9 @@ impl ContactPair {
     /// Make every point's state (and the integrated face's kinematics) whole on every process
     /// from their owners' (collective; nothing without a share): after a converged step, for the
     /// outputs and [`reaction`](Self::reaction), [`pressures`](Self::pressures),
-    /// [`max_penetration`](Self::max_penetration), which read every point.
+    /// [`max_penetration`](Self::max_penetration), which read every point; with friction, every
+    /// point's friction state too ([`PointShare::gather_friction`]), so that the step's commit and
+    /// the friction outputs are the whole punch's.
     pub fn gather_state(&mut self) -> crate::Result<()> {
         let Some(share) = &self.share else { return Ok(()) };
         let mut buf = vec![0.0; 6 * self.points.len()];
@@ -299,6 +301,9 @@ impl ContactPair {
         share.reduce.sum(&mut buf)?;
         for (s, b) in self.state.iter_mut().zip(buf.chunks_exact(6)) {
             *s = PointState { psi: b[0], grad: [b[1], b[2], b[3]], lambda: b[4], active: b[5] != 0.0 };
+        }
+        if let Some(f) = &mut self.friction {
+            share.gather_friction(f)?;
         }
         if let Some(face) = &self.face {
             let n = face.quadrature.len();
