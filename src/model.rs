@@ -506,11 +506,10 @@ impl<E: Element> NonlinearProblem for Model<E> {
                 }
                 if with_tangent {
                     // friction's tangent is not symmetric: the preconditioner gets a symmetric
-                    // stand-in (see stamp::contact::PointFriction)
+                    // stand-in (see stamp::contact::PointFriction). With a share the pair lists
+                    // only this process's entries: the rows of its own points and its part of a
+                    // force-driven punch's row (summed in sum_border)
                     for &(r, c, v, pv) in pair.friction_entries() {
-                        if !mine(r, c) {
-                            continue;
-                        }
                         if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
                             if let Some(s) = pattern.find(re, ce) {
                                 values[s] += v;

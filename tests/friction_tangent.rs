@@ -1,11 +1,12 @@
 //! With Coulomb friction the assembled tangent of a model (plate plus a curved punch) is still the
 //! derivative of its residual: compared with central finite differences at a random
 //! large-displacement state where some points stick and some slip, with the punch moved by a
-//! prescribed displacement or pressed by a force (its travel an unknown).
+//! prescribed displacement or pressed by a force (its travel an unknown); with the nodal and the
+//! integrated contact discretisation (friction at the face's quadrature points).
 
 mod common;
 use common::*;
-use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive, SLIP, STICK};
+use stamp::contact::{ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive, SLIP, STICK};
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
@@ -31,6 +32,12 @@ fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
 /// stick, some slip) and a random tangential multiplier. Returns the model, evaluated once with
 /// the tangent there, and the state.
 fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>) -> (Model<PlateElements>, Vec<f64>) {
+    model_with(surface, seed, mu, drive, false)
+}
+
+/// [`model_at`] with the nodal contact or the `integrated` one (every point's patch coupled in the
+/// pattern: the friction's anchors and multipliers are then at the face's quadrature points).
+fn model_with(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>, integrated: bool) -> (Model<PlateElements>, Vec<f64>) {
     let mut mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 3, 3).unwrap();
     let mut rng = Lcg(seed);
     for n in 0..mesh.num_nodes() {
@@ -50,6 +57,11 @@ fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64
         .map(|n| ContactPoint { node: n, x_ref: [mesh.coords[n][0], mesh.coords[n][1], dp], dofs: [0, 1, 2].map(|c| Face::Top.dof(n, c)), weight: areas[n] })
         .collect();
     let mut pair = ContactPair::new("punch", surface, points, 3.0e3, ContactKinematics::Exact);
+    if integrated {
+        let all: Vec<Option<usize>> = (0..mesh.num_nodes()).map(Some).collect();
+        pair = pair.with_face(ContactFace::new(&mesh.coords, &mesh.cells, &all, mesh.num_nodes()).unwrap()).unwrap();
+        pair.coupling_reach = 10.0;
+    }
     pair.entry_fraction = 0.0;
     pair.gauss_newton_entry = false;
     pair.motion = [0.01, -0.02, -0.05].into();
@@ -83,9 +95,9 @@ fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64
 /// The worst entry of (tangent - central differences) over the largest entry of the tangent,
 /// skipping the columns where a point changes its active or stick/slip state.
 fn fd_error(model: &mut Model<PlateElements>, u: &[f64]) -> (f64, usize) {
-    let states = |m: &Model<PlateElements>| -> Vec<(bool, u8)> {
+    let states = |m: &Model<PlateElements>| -> (Vec<bool>, Vec<u8>) {
         let c = &m.contacts[0];
-        c.state.iter().zip(&c.friction.as_ref().unwrap().status).map(|(s, f)| (s.active, *f)).collect()
+        (c.state.iter().map(|s| s.active).collect(), c.friction.as_ref().unwrap().status.clone())
     };
     let k = dense(model.matrix());
     let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -119,7 +131,11 @@ fn fd_error(model: &mut Model<PlateElements>, u: &[f64]) -> (f64, usize) {
 }
 
 fn check(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>) -> f64 {
-    let (mut model, u) = model_at(surface, seed, 0.3, drive);
+    check_scheme(surface, seed, drive, false)
+}
+
+fn check_scheme(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>, integrated: bool) -> f64 {
+    let (mut model, u) = model_with(surface, seed, 0.3, drive, integrated);
     let f = model.contacts[0].friction.as_ref().unwrap();
     let stick = f.status.iter().filter(|&&s| s == STICK).count();
     let slip = f.status.iter().filter(|&&s| s == SLIP).count();
@@ -129,7 +145,7 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Opt
     let asym = (0..k.len()).flat_map(|i| (0..k.len()).map(move |j| (i, j))).fold(0.0f64, |m, (i, j)| m.max((k[i][j] - k[j][i]).abs()));
     assert!(asym > 0.0);
     let (worst, skipped) = fd_error(&mut model, &u);
-    println!("seed {seed}: {stick} stick, {slip} slip, tangent vs differences {worst:e} ({skipped} columns skipped)");
+    println!("seed {seed}, integrated {integrated}: {stick} stick, {slip} slip, tangent vs differences {worst:e} ({skipped} columns skipped)");
     assert!(skipped < k.len() / 4, "{skipped} columns crossed a kink");
     assert!(worst < 1e-6, "model tangent with friction differs from finite differences by {worst:e}");
     worst
@@ -147,6 +163,19 @@ fn friction_tangent_with_a_force_driven_punch_matches_finite_differences() {
     check(Arc::new(s), 21, Some([0.3, -0.2, -1.0]));
     let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
     check(Arc::new(c), 22, Some([0.0, 0.0, -1.0]));
+}
+
+/// The integrated discretisation: friction at the face's quadrature points, whose bound follows
+/// the normal multiplier field sum_a N_a lambda_a (so a slipping quadrature point's traction
+/// depends on the weighted gaps of its cell's points, over their patches); prescribed and
+/// force-driven, sphere and cylinder.
+#[test]
+fn integrated_friction_tangent_matches_finite_differences() {
+    let s = || Arc::new(Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap());
+    check_scheme(s(), 11, None, true);
+    check_scheme(s(), 21, Some([0.3, -0.2, -1.0]), true);
+    let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
+    check_scheme(Arc::new(c), 22, Some([0.0, 0.0, -1.0]), true);
 }
 
 /// mu = 0 is no friction at all: no friction state (so no friction code runs; the bitwise

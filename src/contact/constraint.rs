@@ -254,14 +254,16 @@ impl ContactPair {
             self.friction = None;
             return Ok(());
         }
-        if self.face.is_some() {
-            return Err(crate::StampError::Problem("friction is implemented for the nodal contact scheme only, not the integrated one".into()));
-        }
         if self.kinematics != ContactKinematics::Exact {
             return Err(crate::StampError::Problem("friction needs the exact contact kinematics, not the shallow constraint".into()));
         }
         let g = self.contact_gradient_norm();
-        self.friction = Some(Friction::new(mu, self.eps_reg * g * g, self.points.iter().map(|p| p.x_ref)));
+        // the friction's sites: the points (nodal), the face's quadrature points (integrated)
+        let sites: Vec<[f64; 3]> = match &self.face {
+            None => self.points.iter().map(|p| p.x_ref).collect(),
+            Some(face) => face.quadrature.iter().map(|q| (0..4).fold([0.0; 3], |x, a| std::array::from_fn(|i| x[i] + q.shape[a] * self.points[q.points[a] as usize].x_ref[i]))).collect(),
+        };
+        self.friction = Some(Friction::new(mu, self.eps_reg * g * g, sites.into_iter()));
         Ok(())
     }
 
@@ -303,7 +305,7 @@ impl ContactPair {
             *s = PointState { psi: b[0], grad: [b[1], b[2], b[3]], lambda: b[4], active: b[5] != 0.0 };
         }
         if let Some(f) = &mut self.friction {
-            share.gather_friction(f)?;
+            share.gather_friction(f, if self.face.is_some() { &share.gathers_site } else { &share.own })?;
         }
         if let Some(face) = &self.face {
             let n = face.quadrature.len();
@@ -344,13 +346,11 @@ impl ContactPair {
                 self.lambda_bar[k] = self.state[k].lambda;
             }
         }
-        if self.friction.is_some() {
-            let share = self.share.take();
-            let evaluated = |k: usize| share.as_ref().is_none_or(|s| s.evaluated[k]);
+        if let Some(n) = self.friction.as_ref().map(|f| f.status.len()) {
+            let evaluated: Vec<bool> = (0..n).map(|k| self.evaluates_friction(k)).collect();
             if let Some(f) = &mut self.friction {
-                f.augment(evaluated);
+                f.augment(|k| evaluated[k]);
             }
-            self.share = share;
         }
     }
 
@@ -375,7 +375,7 @@ impl ContactPair {
         let violation = gaps.max(self.penetration_where(|k| self.owns(k)));
         match &self.friction {
             None => violation,
-            Some(f) => violation.max(f.stick_violation(|k| Vector3::from(self.state[k].grad).normalize(), |k| self.owns(k))),
+            Some(f) => violation.max(f.stick_violation(|k| self.friction_normal(k), |k| self.counts_friction(k))),
         }
     }
 
@@ -427,9 +427,10 @@ impl ContactPair {
             }
         }
         if let Some(f) = &self.friction {
-            for (p, t) in self.points.iter().zip(&f.traction) {
+            for (k, t) in f.traction.iter().enumerate() {
+                let w = self.friction_weight(k);
                 for i in 0..3 {
-                    r[i] -= p.weight * t[i];
+                    r[i] -= w * t[i];
                 }
             }
         }
@@ -440,9 +441,10 @@ impl ContactPair {
     pub fn friction_force(&self) -> [f64; 3] {
         let mut r = [0.0; 3];
         if let Some(f) = &self.friction {
-            for (p, t) in self.points.iter().zip(&f.traction) {
+            for (k, t) in f.traction.iter().enumerate() {
+                let w = self.friction_weight(k);
                 for i in 0..3 {
-                    r[i] += p.weight * t[i];
+                    r[i] += w * t[i];
                 }
             }
         }
@@ -454,9 +456,14 @@ impl ContactPair {
         self.friction.as_ref().map(|f| f.dissipation.iter().sum())
     }
 
-    /// The numbers of sticking and slipping points at the last evaluation (None without friction).
+    /// The numbers of sticking and slipping points at the last evaluation (None without friction;
+    /// integrated: of the points' states of [`friction_at_points`](Self::friction_at_points)).
     pub fn stick_slip_counts(&self) -> Option<(usize, usize)> {
-        self.friction.as_ref().map(|f| (f.status.iter().filter(|&&s| s == super::STICK).count(), f.status.iter().filter(|&&s| s == super::SLIP).count()))
+        let status = match &self.face {
+            None => self.friction.as_ref()?.status.clone(),
+            Some(_) => self.friction_at_points()?.status,
+        };
+        Some((status.iter().filter(|&&s| s == super::STICK).count(), status.iter().filter(|&&s| s == super::SLIP).count()))
     }
 
     /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point. With the

@@ -95,7 +95,7 @@ impl ContactPair {
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
             // a point that cycled keeps the active-side tangent near the kink (its force stays exact)
             let near_kink = !self.hold_active_set && self.frozen[k] && with_tangent && trial <= rules.band;
-            if self.friction.is_some() {
+            if self.friction.is_some() && !integrated {
                 self.add_friction(k, lambda, active, &grad, hess.as_ref(), &dn, force, with_tangent);
             }
             if !active && !near_kink {
@@ -137,6 +137,9 @@ impl ContactPair {
                 self.needs_coupling = self.tangent_points.iter().zip(&self.coupled).any(|(t, c)| *t && !*c);
             }
             self.add_integrated(&sites, &dn, force, add_tangent, share);
+            if self.friction.is_some() {
+                self.add_integrated_friction(&sites, &dn, force, with_tangent, share);
+            }
         }
         self.site_scratch = sites;
         if first {

@@ -33,7 +33,7 @@
 //! at the nodes; `integrated.rs` the integrated discretisation on a [`ContactFace`];
 //! `recover.rs` the recovered pressure field written beside the nodal one; `friction_law.rs`
 //! Coulomb friction of a nodal point (its return map, its tangent, its history; docs/design.md,
-//! "Friction"); `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
+//! "Friction"); `integrated_friction.rs` the same at the integrated face's quadrature points; `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
 //! `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves; `share.rs` the points
 //! of one process.
 
@@ -43,6 +43,7 @@ mod face;
 mod first_touch;
 mod friction_law;
 mod integrated;
+mod integrated_friction;
 mod kinematics;
 mod motion;
 mod nodal;
@@ -53,6 +54,7 @@ mod share;
 pub use constraint::{ContactKinematics, ContactPair, ContactPoint, PointState};
 pub use face::ContactFace;
 pub use friction_law::{return_map, Friction, PointFriction, OPEN, SLIP, STICK};
+pub use integrated_friction::FrictionAtPoints;
 pub use first_touch::{CONVERGING_TENSION, DEEP_ENTRY_RATIO, ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 pub use motion::{ForceDrive, PunchMotion};
 pub use recover::{recovered_pressure, RecoveredPressure, Recovery, RECOVERY};

@@ -82,18 +82,20 @@ impl PointShare {
 const FRICTION_WORDS: usize = 10;
 
 impl PointShare {
-    /// Make the friction state of every point whole on every process from its owner's
-    /// (collective): the position, traction, tangential multiplier and status of the last
-    /// evaluation (each process evaluated its own points, those of other processes are stale).
+    /// Make the friction state of every site (a point, or the integrated face's quadrature point)
+    /// whole on every process from the one process that gives it (`gives[k]`: this process's own
+    /// points, its `gathers_site`) (collective): the position, traction, tangential multiplier
+    /// and status of the last evaluation (each process evaluated its own sites, those of other
+    /// processes are stale).
     /// Summed over the processes, the others adding zeros, so every process gets the owner's
     /// numbers to the bit. The anchors, slip lengths and dissipations change only in
     /// [`Friction::commit`], which every process then makes on the same whole state: they stay
     /// the same on every process without being sent.
-    pub(super) fn gather_friction(&self, f: &mut Friction) -> crate::Result<()> {
+    pub(super) fn gather_friction(&self, f: &mut Friction, gives: &[bool]) -> crate::Result<()> {
         const W: usize = FRICTION_WORDS;
         let n = f.status.len();
         let mut buf = vec![0.0; W * n];
-        for (k, b) in buf.chunks_exact_mut(W).enumerate().filter(|(k, _)| self.own[*k]) {
+        for (k, b) in buf.chunks_exact_mut(W).enumerate().filter(|(k, _)| gives[*k]) {
             b[0..3].copy_from_slice(&f.position[k]);
             b[3..6].copy_from_slice(&f.traction[k]);
             b[6..9].copy_from_slice(&f.lambda_t_bar[k]);
