@@ -76,6 +76,24 @@ else
   bad "integrated contact: the faer run failed"
 fi
 
+# friction with integrated contact (meshes/sphere-slide-friction.toml with contact = "integrated",
+# its penetration_tolerance 1e-5: the friction state at the face's quadrature points, shared by
+# the ranks whose points are in their cells)
+sed -e 's/^\[solver\]/[solver]\nrel_tol = 1e-12/' -e 's/^friction = 0.2/&\ncontact = "integrated"/' -e 's/^penetration_tolerance = 1e-7/penetration_tolerance = 1e-5/' meshes/sphere-slide-friction.toml >"$work/integrated-friction.toml"
+grep -q '^contact = "integrated"' "$work/integrated-friction.toml" || bad "the integrated friction problem was not made"
+if "$work/stamp-faer" run "$work/integrated-friction.toml" --out "$work/faer-integrated-friction" -q 2>/dev/null; then
+  for ranks in 2 4; do
+    if timeout 300 "${mpirun[@]}" -n "$ranks" "$stamp" run "$work/integrated-friction.toml" --out "$work/p$ranks-integrated-friction" -q 2>"$work/integrated-friction.err" && \
+       python3 .ci/compare_history.py "$work/faer-integrated-friction/history.csv" "$work/p$ranks-integrated-friction/history.csv" 1e-8; then
+      ok
+    else
+      bad "friction with integrated contact on $ranks ranks: $(tail -3 "$work/integrated-friction.err")"
+    fi
+  done
+else
+  bad "friction with integrated contact: the faer run failed"
+fi
+
 # rank 0 cannot make its output folder: the failure is agreed at once, one message on every rank
 t0=$SECONDS
 if timeout 120 "${mpirun[@]}" -n 2 "$stamp" run meshes/sphere-ss.toml --out /proc/stamp-cannot-write -q 2>"$work/folder.err"; then

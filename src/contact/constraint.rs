@@ -243,9 +243,10 @@ impl ContactPair {
     }
 
     /// Coulomb friction of coefficient `mu` between the body and this punch (docs/design.md,
-    /// "Friction"); 0: none (frictionless, the same operations as without this call). Nodal
-    /// contact with exact kinematics only, set after eps_reg (the tangential regularisation is
-    /// eps_reg |grad Psi|^2 where the punch touches).
+    /// "Friction"); 0: none (frictionless, the same operations as without this call). Exact
+    /// kinematics only, set after eps_reg (the tangential regularisation is eps_reg |grad Psi|^2
+    /// where the punch touches) and after the integrated face if any ([`with_face`](Self::with_face):
+    /// the friction state is then at the face's quadrature points).
     pub fn set_friction(&mut self, mu: f64) -> crate::Result<()> {
         if !(mu.is_finite() && mu >= 0.0) {
             return Err(crate::StampError::Problem(format!("the friction coefficient must be a finite number >= 0, got {mu}")));

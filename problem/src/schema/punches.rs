@@ -157,7 +157,7 @@ pub struct PunchSpec {
     #[serde(default)]
     pub contact: Option<ContactSpec>,
     /// The Coulomb friction coefficient mu between the plate and the punch (default 0:
-    /// frictionless). Nodal contact with exact kinematics only.
+    /// frictionless). Exact kinematics only; nodal or integrated contact.
     #[serde(default)]
     pub friction: Option<Spanned<FrictionCoefficient>>,
 }
