@@ -78,16 +78,23 @@ fi
 
 # friction with integrated contact (meshes/sphere-slide-friction.toml with contact = "integrated",
 # its penetration_tolerance 1e-5: the friction state at the face's quadrature points, shared by
-# the ranks whose points are in their cells)
+# the ranks whose points are in their cells). 2 and 4 ranks against 1 rank within 1e-8 (measured
+# up to 2.7e-12); 1 rank against the faer run within 1e-7: the two linear solvers' round-off
+# grows along this path of 24 steps and 231 cut-back iterations to 2.2e-8 of the peak pressure
+# (3e-9 of the displacements), on 1 rank as on 4; the same Newton iterations and stick/slip counts
 sed -e 's/^\[solver\]/[solver]\nrel_tol = 1e-12/' -e 's/^friction = 0.2/&\ncontact = "integrated"/' -e 's/^penetration_tolerance = 1e-7/penetration_tolerance = 1e-5/' meshes/sphere-slide-friction.toml >"$work/integrated-friction.toml"
 grep -q '^contact = "integrated"' "$work/integrated-friction.toml" || bad "the integrated friction problem was not made"
+stick_slip="import json,sys; a,b=(json.load(open(f)) for f in sys.argv[1:3]); c=lambda r: (r['newton_iterations'], [(p.get('sticking_nodes'), p.get('slipping_nodes')) for x in r['steps'] for p in x['punches'].values()]); sys.exit(0 if c(a) == c(b) else 1)"
 if "$work/stamp-faer" run "$work/integrated-friction.toml" --out "$work/faer-integrated-friction" -q 2>/dev/null; then
-  for ranks in 2 4; do
-    if timeout 300 "${mpirun[@]}" -n "$ranks" "$stamp" run "$work/integrated-friction.toml" --out "$work/p$ranks-integrated-friction" -q 2>"$work/integrated-friction.err" && \
-       python3 .ci/compare_history.py "$work/faer-integrated-friction/history.csv" "$work/p$ranks-integrated-friction/history.csv" 1e-8; then
+  for ranks in 1 2 4; do
+    out="$work/p$ranks-integrated-friction"
+    if [ "$ranks" = 1 ]; then ref="$work/faer-integrated-friction"; tol=1e-7; else ref="$work/p1-integrated-friction"; tol=1e-8; fi
+    if timeout 300 "${mpirun[@]}" -n "$ranks" "$stamp" run "$work/integrated-friction.toml" --out "$out" -q 2>"$out.err" && \
+       python3 .ci/compare_history.py "$ref/history.csv" "$out/history.csv" "$tol" && \
+       python3 -c "$stick_slip" "$ref/summary.json" "$out/summary.json"; then
       ok
     else
-      bad "friction with integrated contact on $ranks ranks: $(tail -3 "$work/integrated-friction.err")"
+      bad "friction with integrated contact on $ranks ranks differs from $ref, or its Newton iterations or stick/slip counts do: $(tail -3 "$out.err")"
     fi
   done
 else
