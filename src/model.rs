@@ -298,11 +298,6 @@ impl<E: Element> Model<E> {
     /// entries: those of its own elements and the whole rows of its own nodes (every element
     /// around them), the rows and columns of the force-driven punches whole.
     pub fn set_share(&mut self, share: Option<Share>) -> Result<()> {
-        if share.is_some() {
-            if let Some(c) = self.contacts.iter().find(|c| c.friction.is_some()) {
-                return Err(StampError::Problem(format!("punch '{}': friction is not implemented in a distributed run (its state is not shared between the processes)", c.name)));
-            }
-        }
         let (ne, nn) = (self.element.num_elements(), self.dofs.num_nodes());
         self.assembler = match &share {
             Some(s) => {
@@ -511,11 +506,10 @@ impl<E: Element> NonlinearProblem for Model<E> {
                 }
                 if with_tangent {
                     // friction's tangent is not symmetric: the preconditioner gets a symmetric
-                    // stand-in (see stamp::contact::PointFriction)
+                    // stand-in (see stamp::contact::PointFriction). With a share the pair lists
+                    // only this process's entries: the rows of its own points and its part of a
+                    // force-driven punch's row (summed in sum_border)
                     for &(r, c, v, pv) in pair.friction_entries() {
-                        if !mine(r, c) {
-                            continue;
-                        }
                         if let (Some(re), Some(ce)) = (eq(r), eq(c)) {
                             if let Some(s) = pattern.find(re, ce) {
                                 values[s] += v;

@@ -1,12 +1,13 @@
 //! With Coulomb friction the assembled tangent of a model (plate plus a curved punch) is still the
 //! derivative of its residual: compared with central finite differences at a random
 //! large-displacement state where some points stick and some slip, with the punch moved by a
-//! prescribed displacement or pressed by a force (its travel an unknown), and turned by a
-//! prescribed rotation (friction then works in the punch's body frame).
+//! prescribed displacement or pressed by a force (its travel an unknown), turned by a prescribed
+//! rotation (friction then works in the punch's body frame); with the nodal and the integrated
+//! contact discretisation (friction at the face's quadrature points).
 
 mod common;
 use common::*;
-use stamp::contact::{ContactKinematics, ContactPair, ContactPoint, ForceDrive, PunchRotation, SLIP, STICK};
+use stamp::contact::{ContactFace, ContactKinematics, ContactPair, ContactPoint, ForceDrive, PunchRotation, SLIP, STICK};
 use stamp::dofs::DofMap;
 use stamp::mesh::QuadMesh;
 use stamp::model::Model;
@@ -32,11 +33,13 @@ fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
 /// stick, some slip) and a random tangential multiplier. Returns the model, evaluated once with
 /// the tangent there, and the state.
 fn model_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>) -> (Model<PlateElements>, Vec<f64>) {
-    model_turned_at(surface, seed, mu, drive, None)
+    model_turned_at(surface, seed, mu, drive, None, false)
 }
 
-/// [`model_at`] with the punch turned by `rotation` too.
-fn model_turned_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>, rotation: Option<PunchRotation>) -> (Model<PlateElements>, Vec<f64>) {
+/// [`model_at`] with the punch turned by `rotation` too, and with the nodal contact or the
+/// `integrated` one (every point's patch coupled in the pattern: the friction's anchors and
+/// multipliers are then at the face's quadrature points).
+fn model_turned_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, mu: f64, drive: Option<[f64; 3]>, rotation: Option<PunchRotation>, integrated: bool) -> (Model<PlateElements>, Vec<f64>) {
     let mut mesh = QuadMesh::rectangle(0.0, 2.0, 0.0, 2.0, 3, 3).unwrap();
     let mut rng = Lcg(seed);
     for n in 0..mesh.num_nodes() {
@@ -56,6 +59,11 @@ fn model_turned_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, 
         .map(|n| ContactPoint { node: n, x_ref: [mesh.coords[n][0], mesh.coords[n][1], dp], dofs: [0, 1, 2].map(|c| Face::Top.dof(n, c)), weight: areas[n] })
         .collect();
     let mut pair = ContactPair::new("punch", surface, points, 3.0e3, ContactKinematics::Exact);
+    if integrated {
+        let all: Vec<Option<usize>> = (0..mesh.num_nodes()).map(Some).collect();
+        pair = pair.with_face(ContactFace::new(&mesh.coords, &mesh.cells, &all, mesh.num_nodes()).unwrap()).unwrap();
+        pair.coupling_reach = 10.0;
+    }
     pair.entry_fraction = 0.0;
     pair.gauss_newton_entry = false;
     pair.motion = [0.01, -0.02, -0.05].into();
@@ -90,9 +98,9 @@ fn model_turned_at(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, 
 /// The worst entry of (tangent - central differences) over the largest entry of the tangent,
 /// skipping the columns where a point changes its active or stick/slip state.
 fn fd_error(model: &mut Model<PlateElements>, u: &[f64]) -> (f64, usize) {
-    let states = |m: &Model<PlateElements>| -> Vec<(bool, u8)> {
+    let states = |m: &Model<PlateElements>| -> (Vec<bool>, Vec<u8>) {
         let c = &m.contacts[0];
-        c.state.iter().zip(&c.friction.as_ref().unwrap().status).map(|(s, f)| (s.active, *f)).collect()
+        (c.state.iter().map(|s| s.active).collect(), c.friction.as_ref().unwrap().status.clone())
     };
     let k = dense(model.matrix());
     let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -130,7 +138,11 @@ fn check(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Opt
 }
 
 fn check_turned(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>, rotation: Option<PunchRotation>) -> f64 {
-    let (mut model, u) = model_turned_at(surface, seed, 0.3, drive, rotation);
+    check_scheme(surface, seed, drive, rotation, false)
+}
+
+fn check_scheme(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>, rotation: Option<PunchRotation>, integrated: bool) -> f64 {
+    let (mut model, u) = model_turned_at(surface, seed, 0.3, drive, rotation, integrated);
     check_model(&mut model, &u, seed)
 }
 
@@ -138,7 +150,7 @@ fn check_turned(surface: Arc<dyn stamp::surface::ContactSurface>, seed: u64, dri
 fn mixed_seed(surface: &Arc<dyn stamp::surface::ContactSurface>, seed: u64, drive: Option<[f64; 3]>, rotation: &PunchRotation) -> u64 {
     (seed..seed + 40)
         .find(|&s| {
-            let (m, _) = model_turned_at(surface.clone(), s, 0.3, drive, Some(rotation.clone()));
+            let (m, _) = model_turned_at(surface.clone(), s, 0.3, drive, Some(rotation.clone()), false);
             let f = m.contacts[0].friction.as_ref().unwrap();
             f.status.iter().filter(|&&x| x == STICK).count() >= 2 && f.status.iter().filter(|&&x| x == SLIP).count() >= 2
         })
@@ -173,6 +185,19 @@ fn friction_tangent_with_a_force_driven_punch_matches_finite_differences() {
     check(Arc::new(s), 21, Some([0.3, -0.2, -1.0]));
     let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
     check(Arc::new(c), 22, Some([0.0, 0.0, -1.0]));
+}
+
+/// The integrated discretisation: friction at the face's quadrature points, whose bound follows
+/// the normal multiplier field sum_a N_a lambda_a (so a slipping quadrature point's traction
+/// depends on the weighted gaps of its cell's points, over their patches); prescribed and
+/// force-driven, sphere and cylinder.
+#[test]
+fn integrated_friction_tangent_matches_finite_differences() {
+    let s = || Arc::new(Sphere::new(nalgebra::Vector3::new(1.0, 1.0, 1.2), 1.5).unwrap());
+    check_scheme(s(), 11, None, None, true);
+    check_scheme(s(), 21, Some([0.3, -0.2, -1.0]), None, true);
+    let c = Cylinder::new(nalgebra::Vector3::new(0.0, 1.0, 1.0), nalgebra::Vector3::new(1.0, 0.3, 0.0), 1.3).unwrap();
+    check_scheme(Arc::new(c), 22, Some([0.0, 0.0, -1.0]), None, true);
 }
 
 /// A punch turned at the load factor of the state (25 degrees about a tilted axis through a

@@ -433,3 +433,146 @@ fn shares_evaluate_their_own_contact_points_and_agree_with_the_whole_model() {
         assert!(all >= whole_queries, "{kind}: the shares queried {all} times, the whole model {whole_queries}");
     }
 }
+
+/// After a checkpoint, what a share holds of the punch's friction: per site (a point, or the
+/// integrated face's quadrature point: status, traction,
+/// anchor, tangential multiplier, slip, dissipation), the counts of sticking and slipping points,
+/// the friction force, the dissipation, the reaction.
+type FrictionState = (Vec<(u8, [f64; 3], [f64; 3], [f64; 3], f64, f64)>, (usize, usize), [f64; 3], f64, [f64; 3]);
+
+/// One step of Newton's calls on a model with friction, per step: the residuals of its
+/// evaluations, the tangent and preconditioner of its last evaluation with a tangent, and the
+/// friction state after its checkpoint.
+type FrictionStep = (Vec<Vec<f64>>, Entries, Entries, FrictionState);
+
+/// Newton's calls through three steps of a punch pressed and dragged along x1 at load factors
+/// 0.4, 0.7, 1: a step start, evaluations without and with a tangent, a multiplier update and an
+/// evaluation after it, a checkpoint (which commits the slip of the step).
+fn friction_script(m: &mut Model<PlateElements>, states: &[(f64, Vec<f64>)]) -> Vec<FrictionStep> {
+    m.checkpoint();
+    states
+        .iter()
+        .map(|(t, u)| {
+            m.start_step(false);
+            let mut residuals = Vec::new();
+            for tangent in [false, true] {
+                m.evaluate(u, *t, tangent).unwrap();
+                residuals.push(m.residual().to_vec());
+            }
+            m.update_multipliers();
+            m.evaluate(u, *t, true).unwrap();
+            residuals.push(m.residual().to_vec());
+            let (k, p) = (entries(m.matrix()), entries(m.preconditioner().unwrap()));
+            m.checkpoint();
+            let c = &m.contacts[0];
+            let f = c.friction.as_ref().unwrap();
+            let points = (0..f.status.len()).map(|i| (f.status[i], f.traction[i], f.anchor[i], f.lambda_t_bar[i], f.slip[i], f.dissipation[i])).collect();
+            (residuals, k, p, (points, c.stick_slip_counts().unwrap(), c.friction_force(), c.friction_dissipation().unwrap(), c.reaction()))
+        })
+        .collect()
+}
+
+/// Coulomb friction (mu = 0.3) in a distributed model, nodal and integrated contact: a sphere
+/// pressed by a force into a sagging plate and dragged along x1 over three steps. Every share's
+/// residuals are the whole model's; the shares' tangents and preconditioners (friction's
+/// unsymmetric entries and their symmetric stand-ins) add up to the whole's; after each checkpoint
+/// every share holds the whole friction state -- each site's stick or slip, traction, anchor,
+/// tangential multiplier, slip length and dissipation -- and the punch's totals, the whole
+/// model's.
+#[test]
+fn friction_shares_agree_with_the_whole_model() {
+    for integrated in [false, true] {
+        friction_shares_agree(integrated);
+    }
+}
+
+fn friction_shares_agree(integrated: bool) {
+    let mesh = QuadMesh::rectangle(0.0, 2.4, 0.0, 2.2, 12, 11).unwrap();
+    let build = || {
+        let mut m = contact_model(&mesh, integrated, Arc::new(Sphere::new(nalgebra::Vector3::new(1.2, 1.1, 0.1 + 1.0), 1.0).unwrap()));
+        // dragged less with the integrated contact, where a point slips when any of its
+        // quadrature points does
+        let drag = if integrated { 0.003 } else { 0.03 };
+        m.contacts[0].motion = [drag, drag / 3.0, 0.0].into();
+        m.contacts[0].set_friction(0.3).unwrap();
+        m
+    };
+    let mut whole = build();
+    let states: Vec<(f64, Vec<f64>)> = [(0.4, 0.06, 0.09), (0.7, 0.08, 0.12), (1.0, 0.085, 0.125)]
+        .iter()
+        .map(|&(t, d, s)| {
+            let mut u = sag(&mesh, &whole, d, s);
+            whole.apply_prescribed(&mut u, t);
+            (t, u)
+        })
+        .collect();
+    let want = friction_script(&mut whole, &states);
+    // the script goes through stick and slip, and commits slip
+    let counts: Vec<(usize, usize)> = want.iter().map(|s| s.3 .1).collect();
+    println!("integrated {integrated}, whole model: (sticking, slipping) points after each step {counts:?}");
+    assert!(counts.iter().any(|c| c.0 >= 2) && counts.iter().any(|c| c.1 >= 2), "stick and slip: {counts:?}");
+    let last = &want[want.len() - 1].3;
+    assert!(last.0.iter().filter(|p| p.4 > 0.0).count() >= 2 && last.3 > 0.0, "slip committed: dissipation {}", last.3);
+    let k = &want[want.len() - 1].1;
+    assert!(k.iter().any(|(&(i, j), v)| (v - k.get(&(j, i)).copied().unwrap_or(0.0)).abs() > 1e-6 * v.abs()), "the friction's tangent is not symmetric");
+    let border = whole.num_equations() - 1;
+    let runs: Vec<Vec<FrictionStep>> = std::thread::scope(|s| {
+        let handles: Vec<_> = shares(&mesh)
+            .0
+            .into_iter()
+            .map(|(share, _)| {
+                let (build, states) = (&build, &states);
+                s.spawn(move || {
+                    let mut m = build();
+                    m.set_share(Some(share)).unwrap();
+                    friction_script(&mut m, states)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-11 * scale.max(1e-300);
+    let max_abs = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0f64, |m, x| m.max(x.abs()));
+    for (step, w) in want.iter().enumerate() {
+        let (wp, wcounts, wforce, wdiss, wreaction) = &w.3;
+        let t_scale = max_abs(&mut wp.iter().flat_map(|p| p.1.into_iter().chain(p.3)));
+        let a_scale = max_abs(&mut wp.iter().flat_map(|p| p.2));
+        let f_scale = max_abs(&mut wforce.iter().chain(wreaction).copied());
+        for (i, run) in runs.iter().enumerate() {
+            let (residuals, _, _, (points, counts, force, diss, reaction)) = &run[step];
+            for (a, b) in residuals.iter().zip(&w.0) {
+                let scale = max_abs(&mut b.iter().copied());
+                let dr = a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+                assert!(dr <= 1e-11 * scale, "integrated {integrated}, step {step}, share {i}: residual differs by {dr:e} of {scale:e}");
+            }
+            assert_eq!(counts, wcounts, "integrated {integrated}, step {step}, share {i}: sticking and slipping points");
+            for (k, (a, b)) in points.iter().zip(wp).enumerate() {
+                let same = a.0 == b.0
+                    && (0..3).all(|c| close(a.1[c], b.1[c], t_scale) && close(a.2[c], b.2[c], a_scale) && close(a.3[c], b.3[c], t_scale))
+                    && close(a.4, b.4, a_scale)
+                    && close(a.5, b.5, *wdiss);
+                assert!(same, "integrated {integrated}, step {step}, share {i}, point {k}: {a:?} against the whole model's {b:?}");
+            }
+            assert!(close(*diss, *wdiss, *wdiss), "integrated {integrated}, step {step}, share {i}: dissipation {diss} against {wdiss}");
+            assert!((0..3).all(|c| close(force[c], wforce[c], f_scale) && close(reaction[c], wreaction[c], f_scale)), "integrated {integrated}, step {step}, share {i}: friction force {force:?} against {wforce:?}");
+        }
+        // the shares' tangents and preconditioners add up to the whole's (the border whole in each)
+        let (k, p) = (&w.1, &w.2);
+        let kscale = max_abs(&mut k.values().copied());
+        let (mut ks, mut ps): (Entries, Entries) = (BTreeMap::new(), BTreeMap::new());
+        for run in &runs {
+            for (ij, v) in &run[step].1 {
+                *ks.entry(*ij).or_default() += v;
+            }
+            for (ij, v) in &run[step].2 {
+                *ps.entry(*ij).or_default() += v;
+            }
+        }
+        for (&(i, j), &whole_k) in k {
+            let parts = if i == border || j == border { PARTS as f64 } else { 1.0 };
+            let (sum_k, sum_p) = (ks[&(i, j)] / parts, ps[&(i, j)] / parts);
+            assert!((sum_k - whole_k).abs() <= 1e-11 * kscale, "integrated {integrated}, step {step}: tangent ({i}, {j}): shares add to {sum_k}, whole {whole_k}");
+            assert!((sum_p - p[&(i, j)]).abs() <= 1e-11 * kscale, "integrated {integrated}, step {step}: preconditioner ({i}, {j}): shares add to {sum_p}, whole {}", p[&(i, j)]);
+        }
+    }
+}

@@ -63,11 +63,18 @@ fn column(head: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
     rows.iter().map(|r| r[c]).collect()
 }
 
+/// With the nodal and the integrated contact (friction at the face's quadrature points).
 #[test]
 fn sliding_drag_is_mu_times_the_normal_force() {
+    for contact in ["nodal", "integrated"] {
+        sliding_drag(contact);
+    }
+}
+
+fn sliding_drag(contact: &str) {
     let tan_a = 0.1f64;
     for (mu, inclined) in [(0.1, 0.20202020202020202), (0.2, 0.30612244897959184), (0.3, 0.41237113402061855)] {
-        let out = run(&format!("friction-{mu}"), &problem(&mu.to_string(), ""));
+        let out = run(&format!("friction-{contact}-{mu}"), &problem(&mu.to_string(), &format!("contact = \"{contact}\"")));
         let (head, rows) = history(&out);
         let (f1, f2, f3) = (column(&head, &rows, "flat_force_x1"), column(&head, &rows, "flat_force_x2"), column(&head, &rows, "flat_force_x3"));
         let dissipation = column(&head, &rows, "flat_dissipation");
@@ -79,9 +86,9 @@ fn sliding_drag_is_mu_times_the_normal_force() {
         // the inclined plane: the same forces in axes turned by a about x2
         let (c, s) = (1.0 / (1.0 + tan_a * tan_a).sqrt(), tan_a / (1.0 + tan_a * tan_a).sqrt());
         let (h, v) = (-f1[last] * c + f3[last] * s, f3[last] * c + f1[last] * s);
-        println!("mu = {mu}: drag/normal {ratio:.12} (error {:.2e}), F/G {:.12} against {inclined:.12} (error {:.2e}), |F2| / F3 {:.1e}, dissipation {:e}", ratio / mu - 1.0, h / v, h / v / inclined - 1.0, f2[last].abs() / f3[last], dissipation[last]);
-        assert!((ratio / mu - 1.0).abs() < 1e-6, "mu = {mu}: drag / normal force = {ratio}");
-        assert!((h / v / inclined - 1.0).abs() < 1e-6, "mu = {mu}: F/G = {}, expected {inclined}", h / v);
+        println!("{contact}, mu = {mu}: drag/normal {ratio:.12} (error {:.2e}), F/G {:.12} against {inclined:.12} (error {:.2e}), |F2| / F3 {:.1e}, dissipation {:e}", ratio / mu - 1.0, h / v, h / v / inclined - 1.0, f2[last].abs() / f3[last], dissipation[last]);
+        assert!((ratio / mu - 1.0).abs() < 1e-6, "{contact}, mu = {mu}: drag / normal force = {ratio}");
+        assert!((h / v / inclined - 1.0).abs() < 1e-6, "{contact}, mu = {mu}: F/G = {}, expected {inclined}", h / v);
         assert!(f2[last].abs() < 1e-6 * f3[last]);
         // before the slide (pressing only, t <= 0.5) no net drag (the points that slide as the plate
         // bends cancel); the dissipation never decreases
@@ -127,7 +134,6 @@ fn bad_friction_is_refused_with_the_key() {
     for (mu, extra, want) in [
         ("-0.1", "", "friction"),
         ("11.0", "", "friction"),
-        ("0.2", "contact = \"integrated\"", "punch[0].friction"),
         ("0.2", "kinematics = \"shallow\"", "punch[0].friction"),
     ] {
         let file = write(&dir, "p.toml", &problem(mu, extra));

@@ -251,9 +251,10 @@ impl ContactPair {
     }
 
     /// Coulomb friction of coefficient `mu` between the body and this punch (docs/design.md,
-    /// "Friction"); 0: none (frictionless, the same operations as without this call). Nodal
-    /// contact with exact kinematics only, set after eps_reg (the tangential regularisation is
-    /// eps_reg |grad Psi|^2 where the punch touches).
+    /// "Friction"); 0: none (frictionless, the same operations as without this call). Exact
+    /// kinematics only, set after eps_reg (the tangential regularisation is eps_reg |grad Psi|^2
+    /// where the punch touches) and after the integrated face if any ([`with_face`](Self::with_face):
+    /// the friction state is then at the face's quadrature points).
     pub fn set_friction(&mut self, mu: f64) -> crate::Result<()> {
         if !(mu.is_finite() && mu >= 0.0) {
             return Err(crate::StampError::Problem(format!("the friction coefficient must be a finite number >= 0, got {mu}")));
@@ -262,14 +263,20 @@ impl ContactPair {
             self.friction = None;
             return Ok(());
         }
-        if self.face.is_some() {
-            return Err(crate::StampError::Problem("friction is implemented for the nodal contact scheme only, not the integrated one".into()));
-        }
         if self.kinematics != ContactKinematics::Exact {
             return Err(crate::StampError::Problem("friction needs the exact contact kinematics, not the shallow constraint".into()));
         }
+        if self.face.is_some() && self.rotation.is_some() {
+            // the integrated scheme's friction sites are held in the translated frame only
+            return Err(crate::StampError::Problem("friction on a punch that turns (`rotation`) is implemented for contact = \"nodal\" only, not \"integrated\"".into()));
+        }
         let g = self.contact_gradient_norm();
-        self.friction = Some(Friction::new(mu, self.eps_reg * g * g, self.points.iter().map(|p| p.x_ref)));
+        // the friction's sites: the points (nodal), the face's quadrature points (integrated)
+        let sites: Vec<[f64; 3]> = match &self.face {
+            None => self.points.iter().map(|p| p.x_ref).collect(),
+            Some(face) => face.quadrature.iter().map(|q| (0..4).fold([0.0; 3], |x, a| std::array::from_fn(|i| x[i] + q.shape[a] * self.points[q.points[a] as usize].x_ref[i]))).collect(),
+        };
+        self.friction = Some(Friction::new(mu, self.eps_reg * g * g, sites.into_iter()));
         Ok(())
     }
 
@@ -297,7 +304,9 @@ impl ContactPair {
     /// Make every point's state (and the integrated face's kinematics) whole on every process
     /// from their owners' (collective; nothing without a share): after a converged step, for the
     /// outputs and [`reaction`](Self::reaction), [`pressures`](Self::pressures),
-    /// [`max_penetration`](Self::max_penetration), which read every point.
+    /// [`max_penetration`](Self::max_penetration), which read every point; with friction, every
+    /// point's friction state too ([`PointShare::gather_friction`]), so that the step's commit and
+    /// the friction outputs are the whole punch's.
     pub fn gather_state(&mut self) -> crate::Result<()> {
         let Some(share) = &self.share else { return Ok(()) };
         let mut buf = vec![0.0; 6 * self.points.len()];
@@ -307,6 +316,9 @@ impl ContactPair {
         share.reduce.sum(&mut buf)?;
         for (s, b) in self.state.iter_mut().zip(buf.chunks_exact(6)) {
             *s = PointState { psi: b[0], grad: [b[1], b[2], b[3]], lambda: b[4], active: b[5] != 0.0 };
+        }
+        if let Some(f) = &mut self.friction {
+            share.gather_friction(f, if self.face.is_some() { &share.gathers_site } else { &share.own })?;
         }
         if let Some(face) = &self.face {
             let n = face.quadrature.len();
@@ -359,13 +371,11 @@ impl ContactPair {
                 self.lambda_bar[k] = self.state[k].lambda;
             }
         }
-        if self.friction.is_some() {
-            let share = self.share.take();
-            let evaluated = |k: usize| share.as_ref().is_none_or(|s| s.evaluated[k]);
+        if let Some(n) = self.friction.as_ref().map(|f| f.status.len()) {
+            let evaluated: Vec<bool> = (0..n).map(|k| self.evaluates_friction(k)).collect();
             if let Some(f) = &mut self.friction {
-                f.augment(evaluated);
+                f.augment(|k| evaluated[k]);
             }
-            self.share = share;
         }
     }
 
@@ -390,14 +400,7 @@ impl ContactPair {
         let violation = gaps.max(self.penetration_where(|k| self.owns(k)));
         match &self.friction {
             None => violation,
-            Some(f) => {
-                // the anchors are in the punch's body frame: so is the normal
-                let normal = |k: usize| {
-                    let n = Vector3::from(self.state[k].grad).normalize();
-                    self.turn.map_or(n, |t| t.r.tr_mul(&n))
-                };
-                violation.max(f.stick_violation(normal, |k| self.owns(k)))
-            }
+            Some(f) => violation.max(f.stick_violation(|k| self.friction_normal(k), |k| self.counts_friction(k))),
         }
     }
 
@@ -449,9 +452,10 @@ impl ContactPair {
             }
         }
         if let Some(f) = &self.friction {
-            for (p, t) in self.points.iter().zip(&f.traction) {
+            for (k, t) in f.traction.iter().enumerate() {
+                let w = self.friction_weight(k);
                 for i in 0..3 {
-                    r[i] -= p.weight * t[i];
+                    r[i] -= w * t[i];
                 }
             }
         }
@@ -462,9 +466,10 @@ impl ContactPair {
     pub fn friction_force(&self) -> [f64; 3] {
         let mut r = [0.0; 3];
         if let Some(f) = &self.friction {
-            for (p, t) in self.points.iter().zip(&f.traction) {
+            for (k, t) in f.traction.iter().enumerate() {
+                let w = self.friction_weight(k);
                 for i in 0..3 {
-                    r[i] += p.weight * t[i];
+                    r[i] += w * t[i];
                 }
             }
         }
@@ -476,9 +481,14 @@ impl ContactPair {
         self.friction.as_ref().map(|f| f.dissipation.iter().sum())
     }
 
-    /// The numbers of sticking and slipping points at the last evaluation (None without friction).
+    /// The numbers of sticking and slipping points at the last evaluation (None without friction;
+    /// integrated: of the points' states of [`friction_at_points`](Self::friction_at_points)).
     pub fn stick_slip_counts(&self) -> Option<(usize, usize)> {
-        self.friction.as_ref().map(|f| (f.status.iter().filter(|&&s| s == super::STICK).count(), f.status.iter().filter(|&&s| s == super::SLIP).count()))
+        let status = match &self.face {
+            None => self.friction.as_ref()?.status.clone(),
+            Some(_) => self.friction_at_points()?.status,
+        };
+        Some((status.iter().filter(|&&s| s == super::STICK).count(), status.iter().filter(|&&s| s == super::SLIP).count()))
     }
 
     /// Contact pressure q_n = -lambda |grad Psi| (>= 0 in compression) at every point. With the

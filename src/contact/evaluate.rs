@@ -98,7 +98,7 @@ impl ContactPair {
             self.state[k] = PointState { psi, grad: grad.into(), lambda, active };
             // a point that cycled keeps the active-side tangent near the kink (its force stays exact)
             let near_kink = !self.hold_active_set && self.frozen[k] && with_tangent && trial <= rules.band;
-            if self.friction.is_some() && self.add_friction(k, lambda, active, &grad, hess.as_ref(), &dn, force, with_tangent) && own(k) {
+            if self.friction.is_some() && !integrated && self.add_friction(k, lambda, active, &grad, hess.as_ref(), &dn, force, with_tangent) && own(k) {
                 // held on a branch of the friction cone that is not the cone's own
                 changes += 1;
             }
@@ -145,6 +145,9 @@ impl ContactPair {
                 self.needs_coupling = self.tangent_points.iter().zip(&self.coupled).any(|(t, c)| *t && !*c);
             }
             self.add_integrated(&sites, &dn, force, add_tangent, share);
+            if self.friction.is_some() {
+                self.add_integrated_friction(&sites, &dn, force, with_tangent, share);
+            }
         }
         self.site_scratch = sites;
         if first {

@@ -105,9 +105,10 @@ impl ContactPair {
 
     /// The friction's converged step: see [`Friction::commit`].
     pub fn commit_friction(&mut self) {
-        let points = &self.points;
+        let Some(n) = self.friction.as_ref().map(|f| f.status.len()) else { return };
+        let weights: Vec<f64> = (0..n).map(|k| self.friction_weight(k)).collect();
         if let Some(f) = &mut self.friction {
-            f.commit(|k| points[k].weight);
+            f.commit(|k| weights[k]);
         }
     }
 }

@@ -188,19 +188,7 @@ impl ContactPair {
         let mut a_i: Vec<Vector3<f64>> = Vec::new();
         for (i, _) in self.tangent_points.iter().enumerate().filter(|(_, t)| **t) {
             let patch = face.patch(i);
-            a_i.clear();
-            a_i.resize(patch.len(), Vector3::zeros());
-            let mut a_s = 0.0;
-            for &(qk, ai) in face.of_point(i) {
-                let q = &face.quadrature[qk as usize];
-                let (_, grad, grad_s, _) = &sites[qk as usize];
-                let wi = q.weight * q.shape[ai as usize];
-                for b in 0..4 {
-                    let j = patch.binary_search(&q.points[b]).expect("a cell's points are in the patch");
-                    a_i[j] += grad * (wi * q.shape[b]);
-                }
-                a_s += wi * grad_s;
-            }
+            let a_s = weighted_gap_gradient(face, sites, i, &mut a_i);
             let c = self.eps_reg / face.area[i];
             for (j, aj) in a_i.iter().enumerate() {
                 if !own(patch[j]) {
@@ -248,4 +236,25 @@ impl ContactPair {
             })
             .collect()
     }
+}
+
+/// The derivative of point i's weighted gap times its area, a_i = A_i dg_i/du, into `a_i` (one
+/// vector per point of its patch, [`ContactFace::patch`]'s order), and A_i dg_i/ds (returned):
+/// a_i[j] = sum_q w_q N_i(q) N_j(q) grad Psi_q over the quadrature points of i's cells.
+pub(super) fn weighted_gap_gradient(face: &ContactFace, sites: &[Kinematics], i: usize, a_i: &mut Vec<Vector3<f64>>) -> f64 {
+    let patch = face.patch(i);
+    a_i.clear();
+    a_i.resize(patch.len(), Vector3::zeros());
+    let mut a_s = 0.0;
+    for &(qk, ai) in face.of_point(i) {
+        let q = &face.quadrature[qk as usize];
+        let (_, grad, grad_s, _) = &sites[qk as usize];
+        let wi = q.weight * q.shape[ai as usize];
+        for b in 0..4 {
+            let j = patch.binary_search(&q.points[b]).expect("a cell's points are in the patch");
+            a_i[j] += grad * (wi * q.shape[b]);
+        }
+        a_s += wi * grad_s;
+    }
+    a_s
 }

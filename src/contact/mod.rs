@@ -33,10 +33,12 @@
 //! at the nodes; `integrated.rs` the integrated discretisation on a [`ContactFace`];
 //! `recover.rs` the recovered pressure field written beside the nodal one; `friction_law.rs`
 //! Coulomb friction of a nodal point (its return map, its tangent, its history; docs/design.md,
-//! "Friction"); `first_touch.rs` the active-set rules (damped entry and release, holds, flips and freezing);
-//! `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves; `rotation.rs` how it
-//! turns, and `turned.rs` its surface as the rotation places it (Psi, gradient and Hessian, for
-//! every shape); `share.rs` the points
+//! "Friction"); `stick_slip.rs` the stick/slip criterion (the branch of the cone each point is
+//! held on while Newton converges); `integrated_friction.rs` the same law at the integrated face's
+//! quadrature points; `first_touch.rs` the active-set rules (damped entry and release, holds,
+//! flips and freezing); `regularisation.rs` the default eps_reg; `motion.rs` how the punch moves;
+//! `rotation.rs` how it turns, and `turned.rs` its surface as the rotation places it (Psi,
+//! gradient and Hessian, for every shape); `share.rs` the points
 //! of one process.
 
 mod constraint;
@@ -46,6 +48,7 @@ mod first_touch;
 mod friction_law;
 pub mod stick_slip;
 mod integrated;
+mod integrated_friction;
 mod kinematics;
 mod motion;
 mod nodal;
@@ -58,6 +61,7 @@ mod turned;
 pub use constraint::{ContactKinematics, ContactPair, ContactPoint, PointState};
 pub use face::ContactFace;
 pub use friction_law::{return_map, return_map_on, Friction, PointFriction, OPEN, SLIP, STICK};
+pub use integrated_friction::FrictionAtPoints;
 pub use first_touch::{CONVERGING_TENSION, DEEP_ENTRY_RATIO, ENTRY_FRACTION, FIRST_TOUCH_FRACTION, LONE_MAX_FLIPS, RELEASE_FRACTION, STEP_START_ENTRY_FRACTION};
 pub use motion::{ForceDrive, PunchMotion};
 pub use recover::{recovered_pressure, RecoveredPressure, Recovery, RECOVERY};

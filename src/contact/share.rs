@@ -14,8 +14,18 @@
 //!
 //! Between evaluations the state of a point a process does not evaluate is stale; after each
 //! converged step [`super::ContactPair::gather_state`] makes it whole on every process for the
-//! outputs (its pressures, its reaction, its active set).
+//! outputs (its pressures, its reaction, its active set) and, with friction, for the step's
+//! commit ([`PointShare::gather_friction`]).
+//!
+//! Friction needs nothing more: a point's return map reads only its own numbers (its position,
+//! normal multiplier, anchor and tangential multiplier), so its owner decides its stick or slip
+//! alone and every process agrees with it; its force and tangent rows are its node's (the
+//! force-driven punch's row and column summed as the normal ones are); the augmented update of a
+//! point is made by the processes that evaluate it, and the tangential violation that decides
+//! whether to update is the largest over the processes (`Model`'s reduction of
+//! [`super::ContactPair::constraint_violation`]).
 
+use super::friction_law::Friction;
 use super::ContactFace;
 use crate::share::Reduce;
 use std::sync::Arc;
@@ -64,5 +74,41 @@ impl PointShare {
         let force_sites = per_site(&|c| touches(c, &own));
         let gathers_site = per_site(&|c| own[c[0] as usize]);
         PointShare { own, evaluated, sites, force_sites, gathers_site, reduce, leader }
+    }
+}
+
+/// What an evaluation changes of a point's friction state, per point: its position in the
+/// punch's frame (3), its tangential traction (3), its tangential multiplier (3), its status.
+const FRICTION_WORDS: usize = 10;
+
+impl PointShare {
+    /// Make the friction state of every site (a point, or the integrated face's quadrature point)
+    /// whole on every process from the one process that gives it (`gives[k]`: this process's own
+    /// points, its `gathers_site`) (collective): the position, traction, tangential multiplier
+    /// and status of the last evaluation (each process evaluated its own sites, those of other
+    /// processes are stale).
+    /// Summed over the processes, the others adding zeros, so every process gets the owner's
+    /// numbers to the bit. The anchors, slip lengths and dissipations change only in
+    /// [`Friction::commit`], which every process then makes on the same whole state: they stay
+    /// the same on every process without being sent.
+    pub(super) fn gather_friction(&self, f: &mut Friction, gives: &[bool]) -> crate::Result<()> {
+        const W: usize = FRICTION_WORDS;
+        let n = f.status.len();
+        let mut buf = vec![0.0; W * n];
+        for (k, b) in buf.chunks_exact_mut(W).enumerate().filter(|(k, _)| gives[*k]) {
+            b[0..3].copy_from_slice(&f.position[k]);
+            b[3..6].copy_from_slice(&f.traction[k]);
+            b[6..9].copy_from_slice(&f.lambda_t_bar[k]);
+            b[9] = f64::from(f.status[k]);
+        }
+        self.reduce.sum(&mut buf)?;
+        for (k, b) in buf.chunks_exact(W).enumerate() {
+            f.position[k] = [b[0], b[1], b[2]];
+            f.traction[k] = [b[3], b[4], b[5]];
+            f.lambda_t_bar[k] = [b[6], b[7], b[8]];
+            // 0, 1 or 2 exactly (one process adds it, the others zero)
+            f.status[k] = b[9] as u8;
+        }
+        Ok(())
     }
 }

@@ -564,9 +564,6 @@ fn build_punches(p: &Problem, mesh: &MeshData, section: &Section, young: f64, ki
         }
         if let Some(mu) = spec.friction.as_ref().filter(|m| m.get_ref().0 > 0.0) {
             let fkey = format!("{key}.friction");
-            if spec.contact.unwrap_or(DEFAULT_CONTACT) == ContactSpec::Integrated {
-                return Err(p.error_at(mu.span(), &fkey, "friction is implemented for contact = \"nodal\" only, not \"integrated\""));
-            }
             if pair.kinematics != ContactKinematics::Exact {
                 return Err(p.error_at(mu.span(), &fkey, "friction needs kinematics = \"exact\" (the default for a nonlinear plate), not the shallow constraint"));
             }

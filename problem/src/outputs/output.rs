@@ -282,7 +282,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
     // the friction's arrays of the punches with friction
     let mut friction_fields = Vec::new();
     for (info, pair) in cx.punches.iter().zip(&model.contacts) {
-        if let Some(f) = &pair.friction {
+        if let Some(f) = pair.friction_at_points() {
             let (mut traction, mut slip, mut state) = (vec![0.0; 3 * n], vec![0.0; n], vec![0.0; n]);
             for (k, pt) in pair.points.iter().enumerate() {
                 traction[3 * pt.node..3 * pt.node + 3].copy_from_slice(&f.traction[k]);

@@ -186,7 +186,7 @@ pub struct PunchSpec {
     #[serde(default)]
     pub contact: Option<ContactSpec>,
     /// The Coulomb friction coefficient mu between the plate and the punch (default 0:
-    /// frictionless). Nodal contact with exact kinematics only.
+    /// frictionless). Exact kinematics only; nodal or integrated contact.
     #[serde(default)]
     pub friction: Option<Spanned<FrictionCoefficient>>,
     /// The punch's rotation: rows [t, angle in degrees] about `axis` (a cylinder: its own axis,
