@@ -1,0 +1,178 @@
+#!/usr/bin/env python3
+"""Cattaneo-Mindlin partial slip: stamp's verification/cattaneo_mindlin.toml against the 3D model
+verification/3d/cattaneo_mindlin_getfem.py and against Mindlin's half-space solution.
+
+    python3 verification/cattaneo_mindlin.py mesh [--hf 0.125]     # writes verification/cattaneo_mindlin.msh
+    stamp run verification/cattaneo_mindlin.toml                  # -> verification/cattaneo_mindlin/
+    /usr/bin/python3 verification/3d/cattaneo_mindlin_getfem.py --json > cm3d.json
+    python3 verification/cattaneo_mindlin.py compare verification/cattaneo_mindlin cm3d.json
+
+`mesh` writes the plate's graded quadrilateral mesh (gmsh MSH 4.1, ASCII): x1 in [-10, 10],
+x2 in [0, 10], spacing hf up to 1.5 from the contact's centre along each axis, then growing by 1.5
+per cell; groups `sym` (the curve x2 = 0), `plate` (every cell) and `center` (the node at 0, 0).
+
+`compare` reads stamp's history.csv (sphere_force_x1, sphere_force_x3) and the .vtu of every step
+(sphere_state: 0 open, 1 stick, 2 slip, and the nodes' tributary areas from the cells), and the 3D
+model's JSON, and prints per step P, Q and the contact radius a = sqrt(A_c / pi) of both (the half
+model's areas doubled), their differences, and c/a = sqrt(A_stick / A_c) of both against
+Mindlin's (1 - Q / (mu P))^(1/3) with the Q / (mu P) of each model.
+"""
+import argparse
+import csv
+import glob
+import json
+import os
+import re
+import sys
+
+import numpy as np
+
+L, MU_F = 10.0, 0.3
+
+
+def graded(hf, fine, ratio, length):
+    """The same grading as verification/3d/cattaneo_mindlin_getfem.py's."""
+    pts = [0.0]
+    step = hf
+    while pts[-1] < length - 1e-12:
+        if pts[-1] >= fine - 1e-12:
+            step *= ratio
+        nxt = pts[-1] + step
+        if nxt > length - 0.5 * step:
+            nxt = length
+        pts.append(nxt)
+    return np.array(pts)
+
+
+def write_mesh(path, hf, fine, ratio):
+    xp = graded(hf, fine, ratio, L)
+    xs = np.concatenate([-xp[:0:-1], xp])
+    ys = xp
+    nx, ny = len(xs), len(ys)
+    tag = lambda i, j: 1 + i + nx * j  # noqa: E731
+    icen = int(np.argmin(np.abs(xs)))
+    lines = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat",
+             "$PhysicalNames", "3", '0 3 "center"', '1 1 "sym"', '2 2 "plate"', "$EndPhysicalNames",
+             "$Entities", "1 1 1 0",
+             "1 0 0 0 1 3",
+             "1 %.17g 0 0 %.17g 0 0 1 1 0" % (xs[0], xs[-1]),
+             "1 %.17g 0 0 %.17g %.17g 0 1 2 0" % (xs[0], xs[-1], ys[-1]),
+             "$EndEntities"]
+    n = nx * ny
+    lines += ["$Nodes", "1 %d 1 %d" % (n, n), "2 1 0 %d" % n]
+    lines += [str(k) for k in range(1, n + 1)]
+    lines += ["%.17g %.17g 0" % (xs[i], ys[j]) for j in range(ny) for i in range(nx)]
+    lines += ["$EndNodes"]
+    quads = [(tag(i, j), tag(i + 1, j), tag(i + 1, j + 1), tag(i, j + 1))
+             for j in range(ny - 1) for i in range(nx - 1)]
+    segs = [(tag(i, 0), tag(i + 1, 0)) for i in range(nx - 1)]
+    ne = len(quads) + len(segs) + 1
+    lines += ["$Elements", "3 %d 1 %d" % (ne, ne), "0 1 15 1", "1 %d" % tag(icen, 0),
+              "1 1 1 %d" % len(segs)]
+    e = 2
+    for s in segs:
+        lines.append("%d %d %d" % (e, *s))
+        e += 1
+    lines.append("2 1 3 %d" % len(quads))
+    for q in quads:
+        lines.append("%d %d %d %d %d" % (e, *q))
+        e += 1
+    lines += ["$EndElements"]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("%s: %d x %d cells, %d nodes, smallest cell %g" % (path, nx - 1, ny - 1, n, hf))
+
+
+def read_vtu(path, name):
+    """Points, quadrilateral connectivity and one point array of a stamp .vtu (ASCII)."""
+    text = open(path).read()
+
+    def block(tagname, attr=None):
+        pat = r"<DataArray[^>]*" + (r'Name="%s"' % attr if attr else "") + r"[^>]*>(.*?)</DataArray>"
+        sec = text if tagname is None else re.search(r"<%s>(.*?)</%s>" % (tagname, tagname), text, re.S).group(1)
+        return np.array(re.search(pat, sec, re.S).group(1).split(), dtype=float)
+
+    pts = block("Points").reshape(-1, 3)
+    conn = block("Cells", "connectivity").astype(int)
+    offs = block("Cells", "offsets").astype(int)
+    arr = block("PointData", name)
+    return pts, conn, offs, arr
+
+
+def tributary(pts, conn, offs):
+    """int N_i dA for bilinear quadrilaterals (one quarter of each cell's area on the rectangles)."""
+    w = np.zeros(len(pts))
+    start = 0
+    for end in offs:
+        c = conn[start:end]
+        start = end
+        x, y = pts[c, 0], pts[c, 1]
+        area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+        w[c] += area / len(c)
+    return w
+
+
+def stamp_rows(folder):
+    with open(os.path.join(folder, "history.csv")) as f:
+        hist = list(csv.DictReader(f))
+    vtus = sorted(glob.glob(os.path.join(folder, "*.vtu")))
+    vtus = [v for v in vtus if re.search(r"(\d+)\.vtu$", v)]
+    vtus.sort(key=lambda v: int(re.search(r"(\d+)\.vtu$", v).group(1)))
+    rows = []
+    for h, v in zip([h for h in hist if float(h.get("load_factor", h.get("t", 1))) > 0], vtus[-len(hist):]):
+        pts, conn, offs, st = read_vtu(v, "sphere_state")
+        w = tributary(pts, conn, offs)
+        ac = 2.0 * w[st > 0.5].sum()
+        ast = 2.0 * w[np.abs(st - 1.0) < 0.5].sum()
+        on_axis = np.abs(pts[:, 1]) < 1e-12
+        xa = pts[on_axis & (st > 0.5), 0]
+        xs = pts[on_axis & (np.abs(st - 1.0) < 0.5), 0]
+        rows.append({"P": float(h["sphere_force_x3"]), "Q": abs(float(h["sphere_force_x1"])),
+                     "a": float(np.sqrt(ac / np.pi)), "c_over_a": float(np.sqrt(ast / ac)) if ac > 0 else 0.0,
+                     "a_axis": 0.5 * float(xa.max() - xa.min()) if len(xa) else 0.0,
+                     "c_axis": 0.5 * float(xs.max() - xs.min()) if len(xs) else 0.0, "vtu": v})
+    return hist, rows
+
+
+def compare(folder, json_path):
+    ref = json.loads(open(json_path).read().strip().splitlines()[-1])
+    hist, rows = stamp_rows(folder)
+    steps = ref["steps"]
+    if len(rows) != len(steps):
+        sys.exit("stamp wrote %d steps (history.csv and .vtu), the 3D model %d" % (len(rows), len(steps)))
+    print("3D: Q2, %s elements, %d unknowns, kp = kt = %g, %.0f s" %
+          (ref["elements"], ref["unknowns"], ref["penalty"], ref["time"]))
+    print("| d | s | P stamp | P 3D | diff | Q stamp | Q 3D | diff | Q/(mu P) | a stamp | a 3D |"
+          " c/a stamp | c/a 3D | Mindlin (1 - Q/(mu P))^(1/3) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r, g in zip(rows, steps):
+        qs, qg = r["Q"], g["Q"]
+        dq = "%+.2f %%" % (100 * (qs / qg - 1)) if qg > 0 else "-"
+        ratio_g = qg / (MU_F * g["P"])
+        ratio_s = qs / (MU_F * r["P"])
+        mind = "%.3f (3D) / %.3f (stamp)" % ((1 - ratio_g) ** (1 / 3), (1 - ratio_s) ** (1 / 3)) if g["s"] > 0 else "1"
+        print("| %.4f | %.4f | %.2f | %.2f | %+.2f %% | %.2f | %.2f | %s | %.3f | %.3f | %.3f | %.3f | %.3f | %s |" %
+              (g["d"], g["s"], r["P"], g["P"], 100 * (r["P"] / g["P"] - 1), qs, qg, dq, ratio_g,
+               r["a"], g["a"], r["c_over_a"], g["c_over_a"], mind))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    m = sub.add_parser("mesh")
+    m.add_argument("--hf", type=float, default=0.125)
+    m.add_argument("--fine", type=float, default=1.5)
+    m.add_argument("--ratio", type=float, default=1.5)
+    m.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "cattaneo_mindlin.msh"))
+    c = sub.add_parser("compare")
+    c.add_argument("folder")
+    c.add_argument("json")
+    a = ap.parse_args()
+    if a.cmd == "mesh":
+        write_mesh(a.out, a.hf, a.fine, a.ratio)
+    else:
+        compare(a.folder, a.json)
+
+
+if __name__ == "__main__":
+    main()
