@@ -12,22 +12,26 @@ x2 in [0, 10], spacing hf up to 1.5 from the contact's centre along each axis, t
 per cell; groups `sym` (the curve x2 = 0), `plate` (every cell) and `center` (the node at 0, 0).
 
 `compare` reads stamp's history.csv (sphere_force_x1, sphere_force_x3) and the .vtu of every step
-(sphere_state: 0 open, 1 stick, 2 slip, and the nodes' tributary areas from the cells), and the 3D
+(sphere_state: 0 open, 1 stick, 2 slip, and the nodes' tributary areas from the cells; forces and
+areas of the half model doubled), and the 3D
 model's JSON, and prints per step P, Q and the contact radius a = sqrt(A_c / pi) of both (the half
 model's areas doubled), their differences, and c/a = sqrt(A_stick / A_c) of both against
 Mindlin's (1 - Q / (mu P))^(1/3) with the Q / (mu P) of each model.
 """
 import argparse
+import base64
 import csv
 import glob
 import json
 import os
 import re
+import struct
 import sys
+import zlib
 
 import numpy as np
 
-L, MU_F = 10.0, 0.3
+L, MU_F, DEPTH, TRAVEL = 10.0, 0.3, 0.01, 0.0025  # the path of cattaneo_mindlin.toml
 
 
 def graded(hf, fine, ratio, length):
@@ -83,20 +87,38 @@ def write_mesh(path, hf, fine, ratio):
     print("%s: %d x %d cells, %d nodes, smallest cell %g" % (path, nx - 1, ny - 1, n, hf))
 
 
+def _decode(text, dtype):
+    """One inline DataArray of VTK XML: raw base64, or a zlib-compressed one (UInt64 header)."""
+    text = text.strip()
+    first = base64.b64decode(text[:32])
+    nblocks = struct.unpack("<Q", first[:8])[0]
+    hlen = (3 + nblocks) * 8
+    hchars = 4 * ((hlen + 2) // 3)
+    header = struct.unpack("<%dQ" % (3 + nblocks), base64.b64decode(text[:hchars])[:hlen])
+    data = base64.b64decode(text[hchars:])
+    out, pos = [], 0
+    for size in header[3:]:
+        out.append(zlib.decompress(data[pos:pos + size]))
+        pos += size
+    return np.frombuffer(b"".join(out), dtype=dtype)
+
+
 def read_vtu(path, name):
-    """Points, quadrilateral connectivity and one point array of a stamp .vtu (ASCII)."""
+    """Points, quadrilateral connectivity and one point array of a stamp .vtu (zlib, inline)."""
     text = open(path).read()
+    types = {"Float64": "<f8", "Float32": "<f4", "Int64": "<i8", "Int32": "<i4", "UInt8": "u1", "UInt64": "<u8"}
 
-    def block(tagname, attr=None):
-        pat = r"<DataArray[^>]*" + (r'Name="%s"' % attr if attr else "") + r"[^>]*>(.*?)</DataArray>"
-        sec = text if tagname is None else re.search(r"<%s>(.*?)</%s>" % (tagname, tagname), text, re.S).group(1)
-        return np.array(re.search(pat, sec, re.S).group(1).split(), dtype=float)
+    def array(section, attr):
+        sec = re.search(r"<%s>(.*?)</%s>" % (section, section), text, re.S).group(1)
+        for m in re.finditer(r"<DataArray([^>]*)>(.*?)</DataArray>", sec, re.S):
+            if attr is None or 'Name="%s"' % attr in m.group(1):
+                return _decode(m.group(2), types[re.search(r'type="(\w+)"', m.group(1)).group(1)])
+        raise KeyError("%s: no %s in <%s>" % (path, attr, section))
 
-    pts = block("Points").reshape(-1, 3)
-    conn = block("Cells", "connectivity").astype(int)
-    offs = block("Cells", "offsets").astype(int)
-    arr = block("PointData", name)
-    return pts, conn, offs, arr
+    pts = array("Points", None).reshape(-1, 3)
+    conn = array("Cells", "connectivity").astype(int)
+    offs = array("Cells", "offsets").astype(int)
+    return pts, conn, offs, array("PointData", name).astype(float)
 
 
 def tributary(pts, conn, offs):
@@ -119,7 +141,7 @@ def stamp_rows(folder):
     vtus = [v for v in vtus if re.search(r"(\d+)\.vtu$", v)]
     vtus.sort(key=lambda v: int(re.search(r"(\d+)\.vtu$", v).group(1)))
     rows = []
-    for h, v in zip([h for h in hist if float(h.get("load_factor", h.get("t", 1))) > 0], vtus[-len(hist):]):
+    for h, v in zip(hist, vtus):
         pts, conn, offs, st = read_vtu(v, "sphere_state")
         w = tributary(pts, conn, offs)
         ac = 2.0 * w[st > 0.5].sum()
@@ -127,7 +149,9 @@ def stamp_rows(folder):
         on_axis = np.abs(pts[:, 1]) < 1e-12
         xa = pts[on_axis & (st > 0.5), 0]
         xs = pts[on_axis & (np.abs(st - 1.0) < 0.5), 0]
-        rows.append({"P": float(h["sphere_force_x3"]), "Q": abs(float(h["sphere_force_x1"])),
+        t = float(h["load_factor"])
+        d, s = (DEPTH * t / 0.5, 0.0) if t <= 0.5 else (DEPTH, TRAVEL * (t - 0.5) / 0.5)
+        rows.append({"d": d, "s": s, "P": 2.0 * float(h["sphere_force_x3"]), "Q": 2.0 * abs(float(h["sphere_force_x1"])),
                      "a": float(np.sqrt(ac / np.pi)), "c_over_a": float(np.sqrt(ast / ac)) if ac > 0 else 0.0,
                      "a_axis": 0.5 * float(xa.max() - xa.min()) if len(xa) else 0.0,
                      "c_axis": 0.5 * float(xs.max() - xs.min()) if len(xs) else 0.0, "vtu": v})
@@ -137,9 +161,13 @@ def stamp_rows(folder):
 def compare(folder, json_path):
     ref = json.loads(open(json_path).read().strip().splitlines()[-1])
     hist, rows = stamp_rows(folder)
-    steps = ref["steps"]
-    if len(rows) != len(steps):
-        sys.exit("stamp wrote %d steps (history.csv and .vtu), the 3D model %d" % (len(rows), len(steps)))
+    # the 3D model's steps, each with stamp's step at the same (d, s) (stamp may take more steps)
+    key = lambda r: (round(r["d"] / DEPTH, 6), round(r["s"] / TRAVEL, 6))  # noqa: E731
+    by_key = {key(r): r for r in rows}
+    steps = [g for g in ref["steps"] if key(g) in by_key]
+    rows = [by_key[key(g)] for g in steps]
+    if not steps:
+        sys.exit("no step of stamp's run is at a (d, s) of the 3D model's")
     print("3D: Q2, %s elements, %d unknowns, kp = kt = %g, %.0f s" %
           (ref["elements"], ref["unknowns"], ref["penalty"], ref["time"]))
     print("| d | s | P stamp | P 3D | diff | Q stamp | Q 3D | diff | Q/(mu P) | a stamp | a 3D |"
