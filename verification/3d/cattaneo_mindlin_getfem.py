@@ -18,23 +18,24 @@ x2 = 0 a plane of symmetry):
 * Supports: u = 0 on the bottom face x3 = -5, u2 = 0 on x2 = 0 (symmetry), the sides free;
   multipliers on the face traces (exact).
 * Contact of the top face x3 = 5 with the exact sphere, centre C = (s, 0, 5 + R - d), gap
-  g = |X + u - C| - R, normal n = (X + u - C) / |X + u - C|: pressure p = kp neg_part(g) (penalty).
-* Coulomb friction by a penalty with a return map, path dependent through the converged steps
-  only: with w = u - C the plate point's displacement relative to the sphere's material points
-  (the sphere translates without turning) and tau_n the traction of the last converged step at
-  each Gauss point of the top face (an im_data), the trial traction is
-  tau_tr = P (tau_n - kt (w - w_n)), P = I - n n^T, and the friction traction on the plate is
-  tau = Ball_projection(tau_tr, mu p): stick inside the ball, slip on it. A converged step stores
-  tau and w. The penalties kp = kt (--penalty, default 1e9 per unit area and length) leave a
-  penetration p / kp ~ 1.5e-6 against d = 0.01 and an elastic creep tau / kt ~ 4e-7 against
-  travels of 5e-4 and more; --penalty 1e10 moves Q and P by the amounts printed by --penalty-check
-  (docs/verification/friction.md).
+  g = |X + u - C| - R, normal n = (X + u - C) / |X + u - C|, and Coulomb friction, both at the
+  Gauss points (4 x 4 per face) in the form stamp uses (docs/design.md, "Friction"): an augmented
+  Lagrangian with a return map. Per point a normal multiplier lamn, a tangential one lamt and a
+  stick anchor wa (im_data); w = u - (C - C0) is the point's displacement relative to the sphere's
+  material point (the sphere translates without turning). Pressure p = pos_part(lamn - kp g),
+  trial traction tau_tr = P (lamt - kp (w - wa)), P = I - n n^T, friction traction on the plate
+  tau = Ball_projection(tau_tr, mu p) (stick inside the ball, slip on it), the bound from the
+  current pressure. Newton solves with the multipliers fixed; then lamn <- p, lamt <- tau, until
+  the largest penetration and the largest distance of a sticking point from its anchor are below
+  --agtol (1e-7). A converged step moves the anchor of a slipping or open point to where it
+  stands. kp (--penalty, 1e8 per unit area and length) only sets how fast the updates converge.
+* A step whose Newton fails is halved (from the last converged state), at most 20 times.
 * Load path as the stamp problem's: d in --press equal steps, then s in --drag equal steps; Newton
   (GetFEM's, MUMPS) from a linear extrapolation of the last two converged states.
 
 Per step: P and Q, the whole sphere's force along x3 and x1 (twice the half model's; Q the
 magnitude of the tangential force), the contact area A_c and the sticking area A_s of the whole
-face (Gauss points with g < 0, and among them those with |tau_tr| < mu p), a = sqrt(A_c / pi),
+face (Gauss points with p > 0, and among them those with |tau_tr| < mu p), a = sqrt(A_c / pi),
 c / a = sqrt(A_s / A_c), and the contact and stick radii along the x1 axis (the outermost Gauss
 points of the row nearest x2 = 0).
 """
@@ -226,11 +227,10 @@ def main():
                      "a": float(np.sqrt(ac / np.pi)),
                      "c_over_a": float(np.sqrt(ast / ac)) if ac > 0 else 0.0,
                      "a_axis": float(rc), "c_axis": float(rs)})
-        if not a.json:
-            r_ = rows[-1]
-            print("  %8.5f  %9.6f  %10.3f  %10.4f  %7.4f  %7.4f   (Newton %d, updates %d, cut-backs %d, %.0f s)" %
+        r_ = rows[-1]
+        print("  %8.5f  %9.6f  %10.3f  %10.4f  %7.4f  %7.4f   (Newton %d, updates %d, cut-backs %d, %.0f s)" %
                   (d, s, r_["P"], r_["Q"], r_["a"], r_["c_over_a"], stats["newton"], stats["uzawa"],
-                   stats["cutbacks"], time.time() - t0), flush=True)
+                   stats["cutbacks"], time.time() - t0), flush=True, file=sys.stderr if a.json else sys.stdout)
     iters = stats["newton"]
     out = {"hf": a.hf, "fine": a.fine, "ratio": a.ratio, "penalty": a.penalty, "mu": a.mu,
            "elements": [len(xs) - 1, len(xp) - 1, len(zs) - 1], "unknowns": int(nunk),
