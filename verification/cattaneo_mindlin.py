@@ -2,7 +2,7 @@
 """Cattaneo-Mindlin partial slip: stamp's verification/cattaneo_mindlin.toml against the 3D model
 verification/3d/cattaneo_mindlin_getfem.py and against Mindlin's half-space solution.
 
-    python3 verification/cattaneo_mindlin.py mesh [--hf 0.1667]     # writes verification/cattaneo_mindlin.msh
+    python3 verification/cattaneo_mindlin.py mesh [--hf 0.25]     # writes verification/cattaneo_mindlin.msh
     stamp run verification/cattaneo_mindlin.toml                  # -> verification/cattaneo_mindlin/
     /usr/bin/python3 verification/3d/cattaneo_mindlin_getfem.py --json > cm3d.json
     python3 verification/cattaneo_mindlin.py compare verification/cattaneo_mindlin cm3d.json
@@ -188,7 +188,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     m = sub.add_parser("mesh")
-    m.add_argument("--hf", type=float, default=1.0 / 6.0)
+    m.add_argument("--hf", type=float, default=0.25)
     m.add_argument("--fine", type=float, default=1.5)
     m.add_argument("--ratio", type=float, default=1.5)
     m.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "cattaneo_mindlin.msh"))
