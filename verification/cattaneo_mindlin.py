@@ -3,9 +3,10 @@
 verification/3d/cattaneo_mindlin_getfem.py and against Mindlin's half-space solution.
 
     python3 verification/cattaneo_mindlin.py mesh [--hf 0.25]     # writes verification/cattaneo_mindlin.msh
-    stamp run verification/cattaneo_mindlin.toml                  # -> verification/cattaneo_mindlin/
+    stamp run verification/cattaneo_mindlin.toml                  # -> verification/cattaneo_mindlin-out/
     /usr/bin/python3 verification/3d/cattaneo_mindlin_getfem.py --json > cm3d.json
-    python3 verification/cattaneo_mindlin.py compare verification/cattaneo_mindlin cm3d.json
+    python3 verification/cattaneo_mindlin.py compare verification/cattaneo_mindlin-out cm3d.json
+    python3 verification/cattaneo_mindlin.py mindlin verification/cattaneo_mindlin-out
 
 `mesh` writes the plate's graded quadrilateral mesh (gmsh MSH 4.1, ASCII): x1 in [-10, 10],
 x2 in [0, 10], spacing hf up to 1.5 from the contact's centre along each axis, then growing by 1.5
@@ -184,6 +185,24 @@ def compare(folder, json_path):
                r["a"], g["a"], r["c_over_a"], g["c_over_a"], mind))
 
 
+def mindlin(folder):
+    """stamp's drag against Mindlin's half-space: Q for the travel s with stamp's P and Hertz's
+    a = sqrt(R d) = 1, and c/a against (1 - Q / (mu P))^(1/3)."""
+    e_mod, nu, a_hertz = 2.1e5, 0.3, 1.0
+    g_mod = e_mod / (2 * (1 + nu))
+    _, rows = stamp_rows(folder)
+    print("| travel s | P | Q stamp | Q / (mu P) | Q Mindlin | stamp / Mindlin | c/a stamp | (1 - Q / (mu P))^(1/3) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        if r["s"] <= 0:
+            continue
+        s0 = 3 * MU_F * r["P"] * (2 - nu) / (16 * g_mod * a_hertz)
+        q_m = MU_F * r["P"] * (1 - (1 - min(r["s"] / s0, 1.0)) ** 1.5)
+        qr = r["Q"] / (MU_F * r["P"])
+        print("| %.4f | %.1f | %.1f | %.3f | %.1f | %+.1f %% | %.3f | %.3f |" %
+              (r["s"], r["P"], r["Q"], qr, q_m, 100 * (r["Q"] / q_m - 1), r["c_over_a"], max(1 - qr, 0) ** (1 / 3)))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -192,12 +211,16 @@ def main():
     m.add_argument("--fine", type=float, default=1.5)
     m.add_argument("--ratio", type=float, default=1.5)
     m.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "cattaneo_mindlin.msh"))
+    mi = sub.add_parser("mindlin")
+    mi.add_argument("folder")
     c = sub.add_parser("compare")
     c.add_argument("folder")
     c.add_argument("json")
     a = ap.parse_args()
     if a.cmd == "mesh":
         write_mesh(a.out, a.hf, a.fine, a.ratio)
+    elif a.cmd == "mindlin":
+        mindlin(a.folder)
     else:
         compare(a.folder, a.json)
 
