@@ -52,7 +52,12 @@ fn run(name: &str, text: &str) -> PathBuf {
 }
 
 fn history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    table(&dir.join("history.csv"))
+}
+
+/// A CSV file of numbers: its header and its rows.
+fn table(file: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(file).unwrap();
     let mut lines = text.lines();
     let head = lines.next().unwrap().split(',').map(String::from).collect();
     (head, lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect())
@@ -110,6 +115,20 @@ fn sliding_drag(contact: &str) {
         let text = std::fs::read_to_string(vtu).unwrap();
         for a in ["flat_traction", "flat_slip", "flat_state"] {
             assert!(text.contains(&format!("Name=\"{a}\"")), "no array {a}");
+        }
+        // the default probe's CSV carries the traction's components: every sliding node's traction
+        // is mu times its pressure against the motion, and so is the bilinear interpolation
+        // between nodes along the line (nodal contact; the integrated scheme's nodal view is a
+        // consistent force over an area)
+        let csv = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("probe_flat_") && p.extension().is_some_and(|e| e == "csv")).max().unwrap();
+        let (ph, pr) = table(&csv);
+        let (q, tx, ty, tz) = (column(&ph, &pr, "flat_pressure"), column(&ph, &pr, "flat_traction_x1"), column(&ph, &pr, "flat_traction_x2"), column(&ph, &pr, "flat_traction_x3"));
+        let qmax = q.iter().cloned().fold(0.0, f64::max);
+        assert!(qmax > 0.0 && tx.iter().any(|&t| t < 0.0), "no traction along the probe");
+        if contact == "nodal" {
+            for k in 0..q.len() {
+                assert!((tx[k] + mu * q[k]).abs() < 1e-6 * mu * qmax && ty[k].abs() < 1e-6 * mu * qmax && tz[k].abs() < 1e-6 * mu * qmax, "probe row {k}: traction ({}, {}, {}) against mu q = {}", tx[k], ty[k], tz[k], mu * q[k]);
+            }
         }
     }
 }

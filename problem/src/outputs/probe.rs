@@ -24,7 +24,8 @@
 //! roller the last row's integral is the load per unit length; where the contact is a line
 //! narrower than the cells, the nodes next to the line carry it in turn and the integral along
 //! one line of an unstructured mesh varies from line to line, while the band's converges (the
-//! force in the band divided by its width). `probe_<name>.png/.svg` draws the contact pressure
+//! force in the band divided by its width). After those, for each punch with friction,
+//! `<punch>_traction_x1`, `_x2`, `_x3`: its tangential traction (the .vtu's `<punch>_traction`). `probe_<name>.png/.svg` draws the contact pressure
 //! (summed over the punches) of up to [`MAX_CURVES`] written steps spread evenly over the load
 //! path, labelled by the first punch's force (force driven) or travel; markers show the points
 //! that are nodes; its title gives the last step's integrals.
@@ -289,6 +290,20 @@ pub fn nodal_pressure(pair: &ContactPair, num_nodes: usize) -> Vec<f64> {
     q
 }
 
+/// The tangential traction of one punch with friction (the .vtu's `<punch>_traction`, force per
+/// unit area of the plate on the punch, global axes) at every node, per component; None without
+/// friction.
+pub fn nodal_traction(pair: &ContactPair, num_nodes: usize) -> Option<[Vec<f64>; 3]> {
+    let f = pair.friction_at_points()?;
+    let mut t = [vec![0.0; num_nodes], vec![0.0; num_nodes], vec![0.0; num_nodes]];
+    for (pt, v) in pair.points.iter().zip(&f.traction) {
+        for (c, tc) in t.iter_mut().enumerate() {
+            tc[pt.node] += v[c];
+        }
+    }
+    Some(t)
+}
+
 /// The recovered contact pressure of one punch ([`stamp::contact::RECOVERY`]) at every node (0
 /// at nodes that are not its candidates).
 pub fn recovered_nodal_pressure(pair: &ContactPair, cells: &[[usize; 4]], num_nodes: usize) -> Vec<f64> {
@@ -402,6 +417,8 @@ impl<'a> Probes<'a> {
         let nn = self.mesh.num_nodes();
         let q: Vec<Vec<f64>> = contacts.iter().map(|c| nodal_pressure(c, nn)).collect();
         let rec: Vec<Vec<f64>> = contacts.iter().map(|c| recovered_nodal_pressure(c, &self.mesh.cells, nn)).collect();
+        // the tangential traction of each punch with friction, per component, at every node
+        let traction: Vec<(&String, [Vec<f64>; 3])> = punch_names.iter().zip(contacts).filter_map(|(n, c)| nodal_traction(c, nn).map(|t| (n, t))).collect();
         let mut files = Vec::new();
         for (line, curves) in self.lines.iter().zip(&mut self.curves) {
             let disp: Vec<Vec<f64>> = (0..3).map(|i| line.interpolate(|n| layout.mid_displacement(u, n)[i])).collect();
@@ -409,9 +426,13 @@ impl<'a> Probes<'a> {
             let recs: Vec<Vec<f64>> = rec.iter().map(|rk| line.interpolate(|n| rk[n])).collect();
             let integrals: Vec<Vec<f64>> = qs.iter().map(|v| line.running_integral(v)).collect();
             let loads: Vec<Vec<f64>> = q.iter().map(|qk| line.running_integral(&line.band_mean(|n| qk[n]))).collect();
+            let tractions: Vec<Vec<f64>> = traction.iter().flat_map(|(_, t)| t.iter().map(|tc| line.interpolate(|n| tc[n]))).collect();
             let mut csv = String::from("distance,x1,x2,u1,u2,u3");
             for n in punch_names {
                 csv.push_str(&format!(",{n}_pressure,{n}_pressure_recovered,{n}_integral,{n}_line_load"));
+            }
+            for (n, _) in &traction {
+                csv.push_str(&format!(",{n}_traction_x1,{n}_traction_x2,{n}_traction_x3"));
             }
             csv.push('\n');
             let mut points = Vec::with_capacity(line.samples.len());
@@ -422,6 +443,9 @@ impl<'a> Probes<'a> {
                 for (((qk, rk), ik), lk) in qs.iter().zip(&recs).zip(&integrals).zip(&loads) {
                     csv.push_str(&format!(",{:e},{:e},{:e},{:e}", qk[k], rk[k], ik[k], lk[k]));
                     total += qk[k];
+                }
+                for t in &tractions {
+                    csv.push_str(&format!(",{:e}", t[k]));
                 }
                 csv.push('\n');
                 points.push((s.distance, total));
