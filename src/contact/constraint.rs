@@ -305,7 +305,7 @@ impl ContactPair {
     /// from their owners' (collective; nothing without a share): after a converged step, for the
     /// outputs and [`reaction`](Self::reaction), [`pressures`](Self::pressures),
     /// [`max_penetration`](Self::max_penetration), which read every point; with friction, every
-    /// point's friction state too ([`PointShare::gather_friction`]), so that the step's commit and
+    /// point's friction state too (`PointShare::gather_friction`), so that the step's commit and
     /// the friction outputs are the whole punch's.
     pub fn gather_state(&mut self) -> crate::Result<()> {
         let Some(share) = &self.share else { return Ok(()) };
