@@ -228,29 +228,29 @@ pub struct SolverOptions {
     pub friction: f64,
 }
 
-/// The model, the load targets and the settings of `meshes/sphere-ss-displacement.toml` on an
-/// n x n mesh, built as `stamp run` builds them.
+/// The model, the load targets and the settings of the problem file `path` whose text, with its
+/// mesh's n replaced, is `source`, built as `stamp run` builds them.
+fn build_file(path: &str, source: String) -> Result<(stamp_problem::build::Setup, Vec<f64>)> {
+    let p = stamp_problem::Problem::parse(std::path::Path::new(path), source)?;
+    let setup = stamp_problem::build::build(&p)?;
+    let targets = setup.targets.clone();
+    Ok((setup, targets))
+}
+
+/// `meshes/sphere-ss-displacement.toml` on an n x n mesh.
 fn build_displacement(n: usize, predictor: BenchPredictor) -> Result<(stamp_problem::build::Setup, Vec<f64>)> {
     debug_assert!(DISPLACEMENT_PROBLEM.contains(DISPLACEMENT_MESH_N));
     let mut source = DISPLACEMENT_PROBLEM.replacen(DISPLACEMENT_MESH_N, &format!("n = [{n}, {n}]"), 1);
     if predictor == BenchPredictor::Coarse {
         source = source.replacen(DISPLACEMENT_SOLVER, &format!("{DISPLACEMENT_SOLVER}predictor = \"coarse\"\n"), 1);
     }
-    let p = stamp_problem::Problem::parse(std::path::Path::new("meshes/sphere-ss-displacement.toml"), source)?;
-    let setup = stamp_problem::build::build(&p)?;
-    let targets = setup.targets.clone();
-    Ok((setup, targets))
+    build_file("meshes/sphere-ss-displacement.toml", source)
 }
 
-/// The model, the load targets and the settings of `meshes/sphere-slide.toml` on 4n x n cells,
-/// built as `stamp run` builds them.
+/// `meshes/sphere-slide.toml` on 4n x n cells.
 fn build_slide(n: usize) -> Result<(stamp_problem::build::Setup, Vec<f64>)> {
     debug_assert!(SLIDE_PROBLEM.contains(SLIDE_MESH_N));
-    let source = SLIDE_PROBLEM.replacen(SLIDE_MESH_N, &format!("n = [{}, {n}]", 4 * n), 1);
-    let p = stamp_problem::Problem::parse(std::path::Path::new("meshes/sphere-slide.toml"), source)?;
-    let setup = stamp_problem::build::build(&p)?;
-    let targets = setup.targets.clone();
-    Ok((setup, targets))
+    build_file("meshes/sphere-slide.toml", SLIDE_PROBLEM.replacen(SLIDE_MESH_N, &format!("n = [{}, {n}]", 4 * n), 1))
 }
 
 /// Solve one size in this process and time it. The deformed plate of the last step is written as

@@ -10,7 +10,7 @@
 
 mod common;
 use common::*;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 fn problem(mu: &str, extra: &str) -> String {
@@ -42,32 +42,6 @@ max_increment = 0.1
     )
 }
 
-fn run(name: &str, text: &str) -> PathBuf {
-    let dir = temp_dir(name);
-    let file = write(&dir, "p.toml", text);
-    let out = dir.join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).args(["run", "-q", "--out", out.to_str().unwrap()]).arg(&file).output().unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    out
-}
-
-fn history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    table(&dir.join("history.csv"))
-}
-
-/// A CSV file of numbers: its header and its rows.
-fn table(file: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(file).unwrap();
-    let mut lines = text.lines();
-    let head = lines.next().unwrap().split(',').map(String::from).collect();
-    (head, lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect())
-}
-
-fn column(head: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
-    let c = head.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {head:?}"));
-    rows.iter().map(|r| r[c]).collect()
-}
-
 /// With the nodal and the integrated contact (friction at the face's quadrature points).
 #[test]
 fn sliding_drag_is_mu_times_the_normal_force() {
@@ -79,7 +53,7 @@ fn sliding_drag_is_mu_times_the_normal_force() {
 fn sliding_drag(contact: &str) {
     let tan_a = 0.1f64;
     for (mu, inclined) in [(0.1, 0.20202020202020202), (0.2, 0.30612244897959184), (0.3, 0.41237113402061855)] {
-        let out = run(&format!("friction-{contact}-{mu}"), &problem(&mu.to_string(), &format!("contact = \"{contact}\"")));
+        let out = run_text(&format!("friction-{contact}-{mu}"), &problem(&mu.to_string(), &format!("contact = \"{contact}\"")));
         let (head, rows) = history(&out);
         let (f1, f2, f3) = (column(&head, &rows, "flat_force_x1"), column(&head, &rows, "flat_force_x2"), column(&head, &rows, "flat_force_x3"));
         let dissipation = column(&head, &rows, "flat_dissipation");
@@ -121,7 +95,7 @@ fn sliding_drag(contact: &str) {
         // between nodes along the line (nodal contact; the integrated scheme's nodal view is a
         // consistent force over an area)
         let csv = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("probe_flat_") && p.extension().is_some_and(|e| e == "csv")).max().unwrap();
-        let (ph, pr) = table(&csv);
+        let (ph, pr) = read_csv(&csv);
         let (q, tx, ty, tz) = (column(&ph, &pr, "flat_pressure"), column(&ph, &pr, "flat_traction_x1"), column(&ph, &pr, "flat_traction_x2"), column(&ph, &pr, "flat_traction_x3"));
         let qmax = q.iter().cloned().fold(0.0, f64::max);
         assert!(qmax > 0.0 && tx.iter().any(|&t| t < 0.0), "no traction along the probe");
@@ -137,7 +111,7 @@ fn sliding_drag(contact: &str) {
 /// frictionless drag zero.
 #[test]
 fn zero_friction_is_frictionless() {
-    let out = run("friction-zero", &problem("0.0", ""));
+    let out = run_text("friction-zero", &problem("0.0", ""));
     let (head, rows) = history(&out);
     assert!(!head.iter().any(|h| h.contains("dissipation")));
     let f1 = column(&head, &rows, "flat_force_x1");
@@ -202,12 +176,12 @@ max_increment = 0.25
         let row: Vec<f64> = text.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect::<Vec<f64>>()).find(|r| r[1] == 0.0 && r[2] == 0.0).unwrap();
         row[3] - row[1]
     };
-    let exact = run("friction-stick-al", &text("penetration_tolerance = 1e-9"));
+    let exact = run_text("friction-stick-al", &text("penetration_tolerance = 1e-9"));
     let s = summary(&exact);
     let last = s["steps"].as_array().unwrap().last().unwrap()["punches"]["ball"].clone();
     assert!(last["sticking_nodes"].as_u64().unwrap() >= 1, "{last}");
     let e_al = (centre_u1(&exact) - 1e-4).abs();
-    let penalty = run("friction-stick-penalty", &text(""));
+    let penalty = run_text("friction-stick-penalty", &text(""));
     let e_pen = (centre_u1(&penalty) - 1e-4).abs();
     println!("centre node's u1 - punch's travel: {e_al:e} with the updates, {e_pen:e} without");
     assert!(e_al < 1e-9, "the sticking centre is {e_al:e} off the punch with the updates");

@@ -32,19 +32,6 @@ fn variant(dir: &Path, name: &str, edits: &[(&str, &str)], mesh: Option<&str>) -
     p
 }
 
-/// A CSV file as its header and rows of numbers.
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(|s| s.to_string()).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap_or_else(|_| panic!("{}: {v:?}", path.display()))).collect()).collect();
-    (header, rows)
-}
-
-fn col(header: &[String], name: &str) -> usize {
-    header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"))
-}
-
 fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }

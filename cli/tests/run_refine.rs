@@ -23,19 +23,6 @@ fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
-/// history.csv as its header and rows of numbers.
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(|s| s.to_string()).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap_or_else(|_| panic!("{v:?}"))).collect()).collect();
-    (header, rows)
-}
-
-fn col(header: &[String], name: &str) -> usize {
-    header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"))
-}
-
 // The quarter of a square plate (side A = 100, h = 1) with hard simple supports (v3 and the
 // tangential in-plane displacement of both faces held), symmetry on x1 = 0 and x2 = 0, under a
 // uniform pressure Q, linear kinematics. The shear-deformable plate's centre deflection is

@@ -7,7 +7,7 @@
 
 mod common;
 use common::*;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// A plate glued to a rigid table (its bottom face held) pressed by `punch`.
@@ -33,27 +33,6 @@ max_increment = {max_increment}
 "#,
         a = -size
     )
-}
-
-fn run(name: &str, text: &str) -> PathBuf {
-    let dir = temp_dir(name);
-    let file = write(&dir, "p.toml", text);
-    let out = dir.join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_stamp")).args(["run", "-q", "--out", out.to_str().unwrap()]).arg(&file).output().unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    out
-}
-
-fn history(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
-    let mut lines = text.lines();
-    let head = lines.next().unwrap().split(',').map(String::from).collect();
-    (head, lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect())
-}
-
-fn column(head: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
-    let c = head.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {head:?}"));
-    rows.iter().map(|r| r[c]).collect()
 }
 
 /// The largest difference between two runs' history.csv, column by column, over the column's
@@ -92,8 +71,8 @@ fn a_tilted_die_presses_as_the_tilted_plane_it_is() {
     let common = "name = \"die\"\nshape = \"plane\"\npoint = [0.0, 0.0, 1.0]\nfriction = 0.2\npenetration_tolerance = 1e-6\n";
     let turned = format!("{common}normal = [0.0, 0.0, -1.0]\n{motion}\nrotation = [[0.5, {degrees}]]\naxis = [0.0, 1.0, 0.0]\npivot = [0.0, 0.0, 1.0]\n");
     let direct = format!("{common}normal = [{}, 0.0, {}]\n{motion}\n", -s, -c);
-    let a = run("rotation-tilted-die", &on_table(2.0, 8, &turned, 0.1));
-    let b = run("rotation-tilted-plane", &on_table(2.0, 8, &direct, 0.1));
+    let a = run_text("rotation-tilted-die", &on_table(2.0, 8, &turned, 0.1));
+    let b = run_text("rotation-tilted-plane", &on_table(2.0, 8, &direct, 0.1));
     let (head, rows) = history(&a);
     let f3 = column(&head, &rows, "die_force_x3");
     let f1 = column(&head, &rows, "die_force_x1");
@@ -143,8 +122,8 @@ fn a_rolling_cylinder_barely_drags_where_a_sliding_one_drags_mu_times_its_load()
 fn a_force_driven_sphere_turning_about_its_centre_presses_as_one_that_does_not() {
     for contact in ["nodal", "integrated"] {
         let sphere = format!("name = \"ball\"\nshape = \"sphere\"\ncenter = [0.0, 0.0, 20.5]\nradius = 20.0\nforce = 2000.0\npenetration_tolerance = 1e-6\ncontact = \"{contact}\"\n");
-        let a = run(&format!("rotation-ball-still-{contact}"), &on_table(4.0, 8, &sphere, 0.25));
-        let b = run(&format!("rotation-ball-turning-{contact}"), &on_table(4.0, 8, &format!("{sphere}rotation = [[1.0, 40.0]]\naxis = [1.0, 1.0, 0.3]\n"), 0.25));
+        let a = run_text(&format!("rotation-ball-still-{contact}"), &on_table(4.0, 8, &sphere, 0.25));
+        let b = run_text(&format!("rotation-ball-turning-{contact}"), &on_table(4.0, 8, &format!("{sphere}rotation = [[1.0, 40.0]]\naxis = [1.0, 1.0, 0.3]\n"), 0.25));
         let d = history_difference(&a, &b);
         println!("force-driven sphere turning about its centre, {contact} contact: history.csv differs by {d:e}");
         assert!(d < 1e-9, "{contact}: history.csv differs by {d:e}");

@@ -17,20 +17,6 @@ use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// history.csv: the header and the rows.
-fn history(out: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(out.join("history.csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
-    assert!(rows.iter().all(|r| r.len() == header.len()), "history.csv: a row's length is not the header's");
-    (header, rows)
-}
-
-fn column(header: &[String], name: &str) -> usize {
-    header.iter().position(|h| h == name).unwrap_or_else(|| panic!("history.csv has no column {name}: {header:?}"))
-}
-
 fn vec3(v: &Value) -> [f64; 3] {
     [0, 1, 2].map(|i| v[i].as_f64().unwrap())
 }
@@ -74,13 +60,13 @@ fn imbalance(out: &Path, weights: &[(&str, f64)], punches: &[&str]) -> (f64, f64
     let (mut worst, mut worst_bound) = (0.0f64, 0.0f64);
     let whole = summary(out);
     for row in &rows {
-        let step = &steps[&(row[column(&header, "step")] as u64)];
+        let step = &steps[&(row[col(&header, "step")] as u64)];
         let supports = step["support_reactions"].as_object().unwrap();
         assert_eq!(supports.len(), weights.len(), "support_reactions: {supports:?}");
         let mut sum = [0.0; 3];
         let mut scale = 0.0f64;
         for (g, w) in weights {
-            let r = [1, 2, 3].map(|k| row[column(&header, &format!("{g}_reaction_x{k}"))]);
+            let r = [1, 2, 3].map(|k| row[col(&header, &format!("{g}_reaction_x{k}"))]);
             // (serde_json's parser may be an ulp off)
             let json = vec3(&supports[*g]);
             assert!((0..3).all(|i| (r[i] - json[i]).abs() <= 1e-15 * r[i].abs()), "{g}: history.csv {r:?} and summary.json {json:?}");
@@ -99,7 +85,7 @@ fn imbalance(out: &Path, weights: &[(&str, f64)], punches: &[&str]) -> (f64, f64
             scale = scale.max(applied[i].abs());
         }
         for p in punches {
-            let f = [1, 2, 3].map(|k| row[column(&header, &format!("{p}_force_x{k}"))]);
+            let f = [1, 2, 3].map(|k| row[col(&header, &format!("{p}_force_x{k}"))]);
             for i in 0..3 {
                 sum[i] -= f[i];
                 scale = scale.max(f[i].abs());
@@ -152,7 +138,7 @@ fn support_reactions_balance_the_punches_and_the_loads() {
         let out = run(&problem, name);
         // the punch pressed the plate at every step
         let (header, rows) = history(&out);
-        assert!(rows.iter().all(|r| r[column(&header, &format!("{punch}_contact_area"))] > 0.0), "{name}: a step without contact");
+        assert!(rows.iter().all(|r| r[col(&header, &format!("{punch}_contact_area"))] > 0.0), "{name}: a step without contact");
         let (worst, bound) = imbalance(&out, &weights, &[punch]);
         eprintln!("{name}: largest imbalance {worst:.2e} of the step's largest force, {bound:.2e} of the bound of Newton's residual");
         assert!(bound <= 1.0, "{name}: supports, loads and punch out of balance by {worst:e} of the forces, beyond Newton's residual");
@@ -258,7 +244,7 @@ fn the_clamp_of_a_cantilever_carries_its_end_force() {
         let out = run(&path, &format!("c{surfaces}"));
         let (header, rows) = history(&out);
         let last = rows.last().unwrap();
-        let r = [1, 2, 3].map(|k| last[column(&header, &format!("bottom_reaction_x{k}"))]);
+        let r = [1, 2, 3].map(|k| last[col(&header, &format!("bottom_reaction_x{k}"))]);
         assert_eq!(header.last().map(String::as_str), Some("bottom_reaction_x3"));
         // to the converged iterate's residual (Newton's tolerance is relative to its force scale:
         // here the internal forces of the clamped end's couple, far above the end force)

@@ -151,3 +151,53 @@ pub fn patch_error(mesh: &QuadMesh, boundary: &[usize], kin: Kinematics, h: f64,
     }
     err / scale
 }
+
+/// A sparse matrix as dense rows (duplicates summed).
+pub fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Vec<Vec<f64>> {
+    let n = m.nrows();
+    let mut d = vec![vec![0.0; n]; n];
+    let (sym, vals) = m.parts();
+    for j in 0..n {
+        for (k, &i) in sym.row_idx()[sym.col_ptr()[j]..sym.col_ptr()[j + 1]].iter().enumerate() {
+            d[i][j] += vals[sym.col_ptr()[j] + k];
+        }
+    }
+    d
+}
+
+/// The tangent `k` of a model's last evaluation at `u` against central differences of its
+/// residual (steps of 1e-7 along each equation): the worst entry of the difference over the
+/// largest entry of `k`, and the number of columns skipped because `state` (the contact's active
+/// set, a friction point's stick or slip) differs between the two sides: a point crossed a kink,
+/// where the derivative does not exist.
+pub fn model_fd_error<S: PartialEq>(model: &mut stamp::model::Model<PlateElements>, u: &[f64], k: &[Vec<f64>], state: impl Fn(&stamp::model::Model<PlateElements>) -> S) -> (f64, usize) {
+    use stamp::nonlinear::NonlinearProblem;
+    let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let neq = model.num_equations();
+    let step = 1e-7;
+    let mut worst = 0.0f64;
+    let mut skipped = 0;
+    for j in 0..neq {
+        let mut du = vec![0.0; neq];
+        du[j] = step;
+        let mut up = u.to_vec();
+        model.add_increment(&mut up, &du);
+        du[j] = -step;
+        let mut um = u.to_vec();
+        model.add_increment(&mut um, &du);
+        model.evaluate(&up, 1.0, false).unwrap();
+        let rp = model.residual().to_vec();
+        let sp = state(model);
+        model.evaluate(&um, 1.0, false).unwrap();
+        if sp != state(model) {
+            skipped += 1;
+            continue;
+        }
+        let rm = model.residual();
+        for i in 0..neq {
+            let fd = (rp[i] - rm[i]) / (2.0 * step);
+            worst = worst.max((fd - k[i][j]).abs() / scale);
+        }
+    }
+    (worst, skipped)
+}

@@ -74,3 +74,41 @@ type = "line"
 group = "top"
 force = [0.0, 0.0, 0.05]
 "#;
+
+/// A CSV file of numbers (history.csv, a probe's): its header and its rows.
+pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(|s| s.to_string()).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap_or_else(|_| panic!("{}: {v:?}", path.display()))).collect()).collect();
+    (header, rows)
+}
+
+/// A run's history.csv: its header and its rows, each as long as the header.
+pub fn history(out: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let (header, rows) = read_csv(&out.join("history.csv"));
+    assert!(rows.iter().all(|r| r.len() == header.len()), "history.csv: a row's length is not the header's");
+    (header, rows)
+}
+
+/// The index of the column `name`.
+pub fn col(header: &[String], name: &str) -> usize {
+    header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+}
+
+/// The values of the column `name`.
+pub fn column(header: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
+    let c = col(header, name);
+    rows.iter().map(|r| r[c]).collect()
+}
+
+/// `stamp run -q` on the problem `text` (written as p.toml into a fresh folder named after
+/// `name`); the run must succeed. Returns its output folder.
+pub fn run_text(name: &str, text: &str) -> PathBuf {
+    let dir = temp_dir(name);
+    let file = write(&dir, "p.toml", text);
+    let out = dir.join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_stamp")).args(["run", "-q", "--out", out.to_str().unwrap()]).arg(&file).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}

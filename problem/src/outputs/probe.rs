@@ -281,13 +281,19 @@ impl ProbeLine {
     }
 }
 
-/// Nodal contact pressure q_n of one punch (0 at nodes that are not its candidates).
-pub fn nodal_pressure(pair: &ContactPair, num_nodes: usize) -> Vec<f64> {
+/// Values given per contact point of `pair`, at every node (0 at nodes that are not its
+/// candidates).
+fn at_nodes(pair: &ContactPair, num_nodes: usize, values: impl IntoIterator<Item = f64>) -> Vec<f64> {
     let mut q = vec![0.0; num_nodes];
-    for (pt, v) in pair.points.iter().zip(pair.pressures()) {
+    for (pt, v) in pair.points.iter().zip(values) {
         q[pt.node] += v;
     }
     q
+}
+
+/// Nodal contact pressure q_n of one punch (0 at nodes that are not its candidates).
+pub fn nodal_pressure(pair: &ContactPair, num_nodes: usize) -> Vec<f64> {
+    at_nodes(pair, num_nodes, pair.pressures())
 }
 
 /// The tangential traction of one punch with friction (the .vtu's `<punch>_traction`, force per
@@ -295,23 +301,13 @@ pub fn nodal_pressure(pair: &ContactPair, num_nodes: usize) -> Vec<f64> {
 /// friction.
 pub fn nodal_traction(pair: &ContactPair, num_nodes: usize) -> Option<[Vec<f64>; 3]> {
     let f = pair.friction_at_points()?;
-    let mut t = [vec![0.0; num_nodes], vec![0.0; num_nodes], vec![0.0; num_nodes]];
-    for (pt, v) in pair.points.iter().zip(&f.traction) {
-        for (c, tc) in t.iter_mut().enumerate() {
-            tc[pt.node] += v[c];
-        }
-    }
-    Some(t)
+    Some(std::array::from_fn(|c| at_nodes(pair, num_nodes, f.traction.iter().map(|t| t[c]))))
 }
 
 /// The recovered contact pressure of one punch ([`stamp::contact::RECOVERY`]) at every node (0
 /// at nodes that are not its candidates).
 pub fn recovered_nodal_pressure(pair: &ContactPair, cells: &[[usize; 4]], num_nodes: usize) -> Vec<f64> {
-    let mut q = vec![0.0; num_nodes];
-    for (pt, v) in pair.points.iter().zip(stamp::contact::recovered_pressure(pair, cells, stamp::contact::RECOVERY).pressure) {
-        q[pt.node] += v;
-    }
-    q
+    at_nodes(pair, num_nodes, stamp::contact::recovered_pressure(pair, cells, stamp::contact::RECOVERY).pressure)
 }
 
 /// One written step of a probe, kept for the plot.
