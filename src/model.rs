@@ -413,6 +413,24 @@ fn owns_row(share: &Option<Share>, dofs_per_node: usize, nd: usize) -> impl Fn(u
     }
 }
 
+impl<E: Element> Model<E> {
+    /// [`Element::commit`] on every element this model evaluates, at the last evaluation's state.
+    fn commit_elements(&mut self) {
+        if !self.element.has_history() || self.last_u.is_empty() {
+            return;
+        }
+        let dpn = self.dofs.dofs_per_node();
+        let mut ws = self.element.new_workspace();
+        let mut local = vec![0.0; dpn * self.element.nodes_per_element()];
+        for &e in self.assembler.elements() {
+            for (a, &n) in self.element.element_nodes(e).iter().enumerate() {
+                local[a * dpn..(a + 1) * dpn].copy_from_slice(&self.last_u[n * dpn..(n + 1) * dpn]);
+            }
+            self.element.commit(e, &local, &mut ws);
+        }
+    }
+}
+
 impl<E: Element> NonlinearProblem for Model<E> {
     fn num_dofs(&self) -> usize {
         self.dofs.num_dofs() + self.num_drives()
@@ -694,6 +712,8 @@ impl<E: Element> NonlinearProblem for Model<E> {
         // converged state's
         self.peak_scale = self.peak_scale.max(self.last_scale);
         self.converged_u.clone_from(&self.last_u);
+        // path-dependent elements (plasticity): the converged state becomes their history
+        self.commit_elements();
         // with a share: every point's state whole on every process (the outputs read it)
         for c in self.contacts.iter_mut() {
             if let Err(e) = c.gather_state() {

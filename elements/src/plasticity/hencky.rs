@@ -88,17 +88,6 @@ fn voigt_strain(m: &Matrix3<f64>) -> [f64; 6] {
     })
 }
 
-fn voigt_stress(m: &Matrix3<f64>) -> [f64; 6] {
-    std::array::from_fn(|a| {
-        let (i, j) = PAIRS[a];
-        if i == j {
-            m[(i, j)]
-        } else {
-            0.5 * (m[(i, j)] + m[(j, i)])
-        }
-    })
-}
-
 fn stress_tensor(s: &[f64; 6]) -> Matrix3<f64> {
     Matrix3::new(s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2])
 }
@@ -181,12 +170,6 @@ impl Hencky {
     }
 }
 
-/// The stress tensor's Voigt form (for tests).
-#[cfg(test)]
-pub(crate) fn as_voigt_stress(m: &Matrix3<f64>) -> [f64; 6] {
-    voigt_stress(m)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -216,6 +199,5 @@ mod tests {
                 }
             }
         }
-        let _ = as_voigt_stress(&Matrix3::identity());
     }
 }

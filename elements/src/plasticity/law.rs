@@ -87,6 +87,12 @@ impl PlasticLaw {
         Some(PointResponse { stress: h.stress(&r.stress), tangent: h.tangent(&r.stress, &r.tangent), state: r.state, yielding: r.yielding, log_strain: h.strain })
     }
 
+    /// The same with the strains themselves for H (the linear theory: small strains).
+    pub fn respond_small(&self, e: &[f64; 6], state: &PlasticState, m: &Quadratic) -> PointResponse {
+        let r = return_map(e, state, &self.stiffness, &self.compliance, m, &self.hardening);
+        PointResponse { stress: r.stress, tangent: r.tangent, state: r.state, yielding: r.yielding, log_strain: *e }
+    }
+
     /// The elastic energy density at the Hencky strain `h` with plastic strain `hp`.
     pub fn elastic_energy(&self, h: &[f64; 6], hp: &[f64; 6]) -> f64 {
         let e: [f64; 6] = std::array::from_fn(|i| h[i] - hp[i]);
