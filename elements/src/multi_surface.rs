@@ -65,6 +65,12 @@ const NVOIGT: usize = 6;
 /// The share of E33's variation over an element that the assumed E33 keeps (see the module doc):
 /// 1 is the displacement-based bilinear E33, 0 its element mean.
 const E33_STABILISATION: f64 = 0.1;
+/// The sub-layers over which a plastic layer is integrated, N levels each: the stresses through
+/// the thickness of a section that yields have kinks where it does, which N Gauss levels miss.
+/// A strip bent to 1.5 to 10 times its first-yield curvature (tests/plasticity_plate.rs), five
+/// surfaces: the moment within 1.5 % of the closed form with 2 sub-layers, 0.23 % with 4, 0.29 %
+/// with 8.
+pub const PLASTIC_SUBLAYERS: usize = 4;
 
 /// The plate with three surfaces (faces and mid-plane): 9 unknowns per node.
 pub type ThreeSurfacePlate = MultiSurfacePlate<3, 12, 36>;
@@ -274,22 +280,15 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
             ));
         }
         let geometry = (0..mesh.num_cells()).map(|c| ElementGeometry::new(&mesh.cell_coords(c), c)).collect::<Result<Vec<_>>>()?;
-        let h = section.thickness();
-        let mid = 0.5 * (section.delta_minus + section.delta_plus);
-        let zs = surface_zetas(N);
-        let mut levels = Vec::new();
-        let mut laws = Vec::new();
-        for (k, layer) in section.layers.iter().enumerate() {
-            laws.push(Law::Isotropic { lambda: layer.material.lame_lambda(), mu: layer.material.shear_modulus() });
-            levels.extend(Level::<N>::of_layer(layer.bottom, layer.top, mid, h, &zs, k));
-        }
+        let (levels, laws) = levels_of::<N>(&section);
         Ok(MultiSurfacePlate { cells: mesh.cells.clone(), geometry: Geometries::new(geometry), levels, laws, section, kinematics, plastic: None })
     }
 
     /// The plate with the layers' `plasticity` (one entry per layer of the section; None keeps a
     /// layer elastic): von Mises or Hill yield functions with isotropic hardening at finite strain
     /// ([`crate::plasticity`]; the linear kinematics takes the strains for the logarithmic ones).
-    /// Every point starts from the virgin state.
+    /// Every point starts from the virgin state. A plastic layer is integrated over
+    /// [`PLASTIC_SUBLAYERS`] sub-layers, which [`MultiSurfacePlate::section`] then lists.
     pub fn with_plasticity(mut self, plasticity: &[Option<Plasticity>]) -> Result<Self> {
         if plasticity.len() != self.section.layers.len() {
             return Err(StampError::Material(format!("{} plasticity entries for {} layers", plasticity.len(), self.section.layers.len())));
@@ -297,6 +296,21 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
         if plasticity.iter().all(Option::is_none) {
             return Ok(self);
         }
+        // each plastic layer integrated over PLASTIC_SUBLAYERS sub-layers of N levels
+        let mut layers = Vec::new();
+        let mut per_layer = Vec::new();
+        for (layer, p) in self.section.layers.iter().zip(plasticity) {
+            let parts = if p.is_some() { PLASTIC_SUBLAYERS } else { 1 };
+            let t = (layer.top - layer.bottom) / parts as f64;
+            for k in 0..parts {
+                let top = if k + 1 == parts { layer.top } else { layer.bottom + (k + 1) as f64 * t };
+                layers.push(crate::material::Layer { bottom: layer.bottom + k as f64 * t, top, material: layer.material });
+                per_layer.push(p.clone());
+            }
+        }
+        self.section.layers = layers;
+        (self.levels, self.laws) = levels_of::<N>(&self.section);
+        let plasticity = &per_layer[..];
         let lame: Vec<(f64, f64)> = self.section.layers.iter().map(|l| (l.material.lame_lambda(), l.material.shear_modulus())).collect();
         self.plastic = Some(PlasticPoints::new(plasticity, &lame, self.cells.len(), self.levels.len(), self.kinematics == Kinematics::Nonlinear)?);
         Ok(self)
@@ -358,8 +372,9 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
             }
             st.ep = st.ep.max(0.0);
             let e6 = strain(geo, samples, 0, g);
-            let r = if p.finite { law.respond(&e6, &st, &m) } else { Some(law.respond_small(&e6, &st, &m)) };
-            r.unwrap_or_else(|| law.respond_small(&e6, &st, &m))
+            let r = if p.finite { law.respond(&e6, &st, &m) } else { law.respond_small(&e6, &st, &m) };
+            // a strain with no logarithm (the state was refused, it is not a converged one)
+            r.unwrap_or(crate::plasticity::law::PointResponse { stress: [f64::NAN; 6], tangent: [[f64::NAN; 6]; 6], state: st, yielding: false, log_strain: e6 })
         }))
     }
 
@@ -409,6 +424,20 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
         compute_samples(&self.geometry[e], &self.levels, self.kinematics, v, ws);
         ws.volume_ratio
     }
+}
+
+/// The integration levels of a section (N per layer) and the laws of its layers.
+fn levels_of<const N: usize>(section: &Section) -> (Vec<Level<N>>, Vec<Law>) {
+    let h = section.thickness();
+    let mid = 0.5 * (section.delta_minus + section.delta_plus);
+    let zs = surface_zetas(N);
+    let mut levels = Vec::new();
+    let mut laws = Vec::new();
+    for (k, layer) in section.layers.iter().enumerate() {
+        laws.push(Law::Isotropic { lambda: layer.material.lame_lambda(), mu: layer.material.shear_modulus() });
+        levels.extend(Level::<N>::of_layer(layer.bottom, layer.top, mid, h, &zs, k));
+    }
+    (levels, laws)
 }
 
 /// The in-plane tangent g0 + u_,i at a level: `dn` the shape-function derivatives, `l` the

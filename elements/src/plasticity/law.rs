@@ -80,17 +80,17 @@ impl PlasticLaw {
     }
 
     /// S and dS/dE at the Green-Lagrange strain `e` from the converged `state`, with the yield
-    /// function `m` of [`PlasticLaw::quadratic_in`]. None when I + 2E is not positive definite.
+    /// function `m` of [`PlasticLaw::quadratic_in`]. None when I + 2E is not positive definite or the return map fails.
     pub fn respond(&self, e: &[f64; 6], state: &PlasticState, m: &Quadratic) -> Option<PointResponse> {
         let h = Hencky::new(e)?;
-        let r = return_map(&h.strain, state, &self.stiffness, &self.compliance, m, &self.hardening);
+        let r = return_map(&h.strain, state, &self.stiffness, &self.compliance, m, &self.hardening)?;
         Some(PointResponse { stress: h.stress(&r.stress), tangent: h.tangent(&r.stress, &r.tangent), state: r.state, yielding: r.yielding, log_strain: h.strain })
     }
 
     /// The same with the strains themselves for H (the linear theory: small strains).
-    pub fn respond_small(&self, e: &[f64; 6], state: &PlasticState, m: &Quadratic) -> PointResponse {
-        let r = return_map(e, state, &self.stiffness, &self.compliance, m, &self.hardening);
-        PointResponse { stress: r.stress, tangent: r.tangent, state: r.state, yielding: r.yielding, log_strain: *e }
+    pub fn respond_small(&self, e: &[f64; 6], state: &PlasticState, m: &Quadratic) -> Option<PointResponse> {
+        let r = return_map(e, state, &self.stiffness, &self.compliance, m, &self.hardening)?;
+        Some(PointResponse { stress: r.stress, tangent: r.tangent, state: r.state, yielding: r.yielding, log_strain: *e })
     }
 
     /// The elastic energy density at the Hencky strain `h` with plastic strain `hp`.

@@ -56,6 +56,6 @@ impl ElementPlasticity<'_> {
     #[inline]
     pub fn respond(&self, law: usize, point: usize, e: &[f64; 6]) -> Option<Option<super::law::PointResponse>> {
         let l = self.laws.get(law)?.as_ref()?;
-        Some(if self.finite { l.respond(e, &self.committed[point], &self.quadratics[law]) } else { Some(l.respond_small(e, &self.committed[point], &self.quadratics[law])) })
+        Some(if self.finite { l.respond(e, &self.committed[point], &self.quadratics[law]) } else { l.respond_small(e, &self.committed[point], &self.quadratics[law]) })
     }
 }

@@ -52,8 +52,12 @@ fn m6(a: &[[f64; 6]; 6]) -> M6 {
 }
 
 /// The return map at strain `h` from the converged `state` (see the module doc). `compliance` is
-/// C^-1 of the elastic stiffness `stiffness`.
-pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6], compliance: &[[f64; 6]; 6], m: &Quadratic, hardening: &Hardening) -> Response {
+/// C^-1 of the elastic stiffness `stiffness`. None for a strain that is not finite or a return
+/// that fails (the state is then refused, and Newton backs off).
+pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6], compliance: &[[f64; 6]; 6], m: &Quadratic, hardening: &Hardening) -> Option<Response> {
+    if !h.iter().all(|x| x.is_finite()) {
+        return None;
+    }
     let c = m6(stiffness);
     let s = m6(compliance);
     let mq = m6(m);
@@ -63,35 +67,37 @@ pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6],
     let phi_tr = phi_of(&trial);
     let (sy0, _) = hardening.yield_stress(state.ep);
     if phi_tr <= sy0 {
-        return Response { stress: trial.into(), tangent: *stiffness, state: *state, yielding: false };
+        return Some(Response { stress: trial.into(), tangent: *stiffness, state: *state, yielding: false });
     }
     // T(dlambda) and g(dlambda), with dg/ddlambda
-    let at = |dl: f64| -> (V6, f64, f64, f64) {
+    let at = |dl: f64| -> Option<(V6, f64, f64, f64)> {
         let a = s + mq * dl;
         let lu = a.lu();
-        let t = lu.solve(&e).expect("C^-1 + dlambda M is positive definite");
+        let t = lu.solve(&e)?;
         let mt = mq * t;
         let phi = t.dot(&mt).max(0.0).sqrt();
-        let dt = -lu.solve(&mt).expect("positive definite");
+        let dt = -lu.solve(&mt)?;
         let dphi = if phi > 0.0 { mt.dot(&dt) / phi } else { 0.0 };
         let (sy, hs) = hardening.yield_stress(state.ep + dl * phi);
         let g = phi - sy;
         let dg = dphi - hs * (phi + dl * dphi);
-        (t, phi, g, dg)
+        g.is_finite().then_some((t, phi, g, dg))
     };
     // a bracket [lo, hi] with g(lo) > 0 > g(hi): von Mises' radial return as the first guess
     let mu3 = 3.0 * c[(3, 3)];
     let mut lo = 0.0;
     let mut hi = (phi_tr / sy0 - 1.0) / mu3.max(f64::MIN_POSITIVE);
     let mut tries = 0;
-    while at(hi).2 > 0.0 {
+    while at(hi)?.2 > 0.0 {
         lo = hi;
         hi *= 4.0;
         tries += 1;
-        assert!(tries < 200, "the return map found no bracket (phi_tr = {phi_tr}, sigma_y = {sy0})");
+        if tries > 200 {
+            return None;
+        }
     }
     let mut dl = hi;
-    let mut result = at(dl);
+    let mut result = at(dl)?;
     for _ in 0..100 {
         let (_, phi, g, dg) = result;
         if g.abs() <= 1e-13 * phi.max(sy0) {
@@ -104,7 +110,7 @@ pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6],
         }
         let newton = dl - g / dg;
         dl = if dg < 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
-        result = at(dl);
+        result = at(dl)?;
         if hi - lo <= 1e-16 * hi {
             break;
         }
@@ -119,8 +125,8 @@ pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6],
     let n = mt / phi;
     j.fixed_view_mut::<1, 6>(6, 0).copy_from(&(n.transpose() * (1.0 - hs * dl)));
     j[(6, 6)] = -hs * phi;
-    let inv = j.try_inverse().expect("the return map's Jacobian is regular");
+    let inv = j.try_inverse()?;
     let tangent: [[f64; 6]; 6] = std::array::from_fn(|a| std::array::from_fn(|b| inv[(a, b)]));
     let hp = std::array::from_fn(|i| state.hp[i] + dl * mt[i]);
-    Response { stress: t.into(), tangent, state: PlasticState { hp, ep: state.ep + dl * phi }, yielding: true }
+    Some(Response { stress: t.into(), tangent, state: PlasticState { hp, ep: state.ep + dl * phi }, yielding: true })
 }
