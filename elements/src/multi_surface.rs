@@ -47,6 +47,7 @@ use crate::geometry::{ElementGeometry, GAUSS_POINTS};
 use crate::material::{NormalStress, Section};
 use crate::orthotropic::Stiffness;
 use crate::plate::Kinematics;
+use crate::plasticity::return_map::YieldBasis;
 use crate::plasticity::{ElementPlasticity, PlasticPoints, PlasticState, Plasticity};
 use crate::strain::{add_geometric_stiffness, axpy, triple, Affine, Sample};
 use faer::linalg::matmul::matmul;
@@ -242,6 +243,8 @@ pub struct MultiSurfaceWorkspace<const P: usize, const D: usize> {
     pub(crate) trial: Vec<PlasticState>,
     /// Set when a plastic point's strain was not admissible (I + 2E not positive definite).
     pub(crate) bad_strain: bool,
+    /// Scratch for the plastic laws' yield functions in the element's frame.
+    bases: Vec<YieldBasis>,
 }
 
 impl<const P: usize, const D: usize> MultiSurfaceWorkspace<P, D> {
@@ -323,10 +326,10 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
 
     /// What element `e`'s kernel reads of the plastic points: `quadratics` is scratch for the
     /// yield functions in its frame.
-    fn element_plasticity<'a>(&'a self, e: usize, quadratics: &'a mut Vec<crate::plasticity::yield_function::Quadratic>) -> Option<ElementPlasticity<'a>> {
+    fn element_plasticity<'a>(&'a self, e: usize, quadratics: &'a mut Vec<YieldBasis>) -> Option<ElementPlasticity<'a>> {
         let p = self.plastic.as_ref()?;
         let geo = &self.geometry[e];
-        *quadratics = p.quadratics(geo.frame[0][1].atan2(geo.frame[0][0]));
+        p.quadratics_into(geo.frame[0][1].atan2(geo.frame[0][0]), quadratics);
         Some(ElementPlasticity { laws: &p.laws, quadratics, committed: p.of_element(e), finite: p.finite })
     }
 
@@ -389,9 +392,11 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
     /// points), for output.
     pub fn resultants(&self, e: usize, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>) -> Resultants {
         let mut r = Resultants::default();
-        let mut quadratics = Vec::new();
+        let mut quadratics = std::mem::take(&mut ws.bases);
         let plastic = self.element_plasticity(e, &mut quadratics);
         resultants_of(&self.geometry[e], &self.levels, &self.laws, plastic.as_ref(), self.kinematics, v, ws, &mut r);
+        drop(plastic);
+        ws.bases = quadratics;
         r
     }
 
@@ -569,7 +574,7 @@ pub(crate) fn resultants_of<const N: usize, const P: usize, const D: usize>(
     for (q, lv) in levels.iter().enumerate() {
         for g in 0..4 {
             let e = strain(geo, &ws.samples, q, g);
-            let s = match plastic.and_then(|p| p.respond(lv.law, 4 * q + g, &e)) {
+            let s = match plastic.and_then(|p| p.respond(lv.law, 4 * q + g, &e, false)) {
                 Some(Some(r)) => r.stress,
                 _ => laws[lv.law].stress(&e),
             };
@@ -604,6 +609,7 @@ pub(crate) fn workspace<const P: usize, const D: usize>(levels: usize) -> MultiS
         volume_ratio: 1.0,
         trial: vec![PlasticState::default(); levels * 4],
         bad_strain: false,
+        bases: Vec::new(),
     }
 }
 
@@ -634,7 +640,7 @@ pub(crate) fn evaluate_levels<const N: usize, const P: usize, const D: usize>(
             let w = geo.wdet[g] * lv.weight;
             let strain = strain(geo, samples, q, g);
             // an elastic level's law, or a plastic point's answer from its converged state
-            let response = plastic.and_then(|p| p.respond(lv.law, 4 * q + g, &strain));
+            let response = plastic.and_then(|p| p.respond(lv.law, 4 * q + g, &strain, with_tangent));
             let law = match response {
                 None => laws[lv.law],
                 Some(Some(r)) => {
@@ -741,7 +747,7 @@ fn linearised_weights<const N: usize, const P: usize, const D: usize>(
         for g in 0..4 {
             let w = geo.wdet[g] * lv.weight;
             let e = strain(geo, linear, q, g);
-            let s = match plastic.and_then(|p| p.respond(lv.law, 4 * q + g, &e)) {
+            let s = match plastic.and_then(|p| p.respond(lv.law, 4 * q + g, &e, false)) {
                 Some(Some(r)) => r.stress,
                 _ => law.stress(&e),
             };
@@ -818,9 +824,11 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
     /// [`Element::evaluate`] and [`Element::evaluate_about`].
     fn evaluate_from(&self, e: usize, v: &[f64], reference: Option<&[f64]>, ws: &mut MultiSurfaceWorkspace<P, D>, out: &mut LocalSystem, with_tangent: bool) {
         let LocalSystem { residual, tangent, energy, .. } = out;
-        let mut quadratics = Vec::new();
+        let mut quadratics = std::mem::take(&mut ws.bases);
         let plastic = self.element_plasticity(e, &mut quadratics);
         evaluate_levels(&self.geometry[e], &self.levels, &self.laws, self.kinematics, v, reference, plastic.as_ref(), ws, residual, tangent, energy, with_tangent);
+        drop(plastic);
+        ws.bases = quadratics;
         if self.kinematics == Kinematics::Nonlinear && ws.volume_ratio <= 0.0 {
             out.inadmissible = Some(inside_out(ws.volume_ratio));
         } else if ws.bad_strain {

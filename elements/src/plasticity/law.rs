@@ -4,7 +4,7 @@
 
 use super::hardening::Hardening;
 use super::hencky::Hencky;
-use super::return_map::{isotropic_stiffness, return_map, PlasticState};
+use super::return_map::{isotropic_stiffness, return_map, PlasticState, YieldBasis};
 use super::yield_function::{hill, turned, von_mises, Quadratic};
 use stamp::Result;
 
@@ -35,6 +35,8 @@ pub struct PlasticLaw {
     compliance: [[f64; 6]; 6],
     quadratic: Quadratic,
     isotropic: bool,
+    /// The yield function's basis in the plate's axes.
+    basis: YieldBasis,
     pub hardening: Hardening,
 }
 
@@ -66,30 +68,38 @@ impl PlasticLaw {
             Some(r) => (hill(r)?, r == [1.0, 1.0, 1.0]),
             None => (von_mises(), true),
         };
-        Ok(PlasticLaw { stiffness: isotropic_stiffness(lambda, mu), compliance, quadratic, isotropic, hardening: plasticity.hardening.clone() })
+        let basis = YieldBasis::new(&quadratic, &compliance);
+        Ok(PlasticLaw { stiffness: isotropic_stiffness(lambda, mu), compliance, quadratic, isotropic, basis, hardening: plasticity.hardening.clone() })
     }
 
     /// The yield function's matrix in axes turned by `angle` about x3 from the plate's (an
     /// element's local frame), computed once per element.
-    pub fn quadratic_in(&self, angle: f64) -> Quadratic {
+    pub fn quadratic_in(&self, angle: f64) -> YieldBasis {
         if self.isotropic || angle == 0.0 {
-            self.quadratic
+            self.basis
         } else {
-            turned(&self.quadratic, angle)
+            YieldBasis::new(&turned(&self.quadratic, angle), &self.compliance)
         }
     }
 
     /// S and dS/dE at the Green-Lagrange strain `e` from the converged `state`, with the yield
     /// function `m` of [`PlasticLaw::quadratic_in`]. None when I + 2E is not positive definite or the return map fails.
-    pub fn respond(&self, e: &[f64; 6], state: &PlasticState, m: &Quadratic) -> Option<PointResponse> {
+    pub fn respond(&self, e: &[f64; 6], state: &PlasticState, m: &YieldBasis) -> Option<PointResponse> {
+        self.respond_with(e, state, m, true)
+    }
+
+    /// [`PlasticLaw::respond`], with the tangent only when `with_tangent` (zeros otherwise: the
+    /// geometric part of dS/dE is the costliest step of the point).
+    pub fn respond_with(&self, e: &[f64; 6], state: &PlasticState, m: &YieldBasis, with_tangent: bool) -> Option<PointResponse> {
         let h = Hencky::new(e)?;
-        let r = return_map(&h.strain, state, &self.stiffness, &self.compliance, m, &self.hardening)?;
-        Some(PointResponse { stress: h.stress(&r.stress), tangent: h.tangent(&r.stress, &r.tangent), state: r.state, yielding: r.yielding, log_strain: h.strain })
+        let r = return_map(&h.strain, state, &self.stiffness, m, &self.hardening)?;
+        let tangent = if with_tangent { h.tangent(&r.stress, &r.tangent) } else { [[0.0; 6]; 6] };
+        Some(PointResponse { stress: h.stress(&r.stress), tangent, state: r.state, yielding: r.yielding, log_strain: h.strain })
     }
 
     /// The same with the strains themselves for H (the linear theory: small strains).
-    pub fn respond_small(&self, e: &[f64; 6], state: &PlasticState, m: &Quadratic) -> Option<PointResponse> {
-        let r = return_map(e, state, &self.stiffness, &self.compliance, m, &self.hardening)?;
+    pub fn respond_small(&self, e: &[f64; 6], state: &PlasticState, m: &YieldBasis) -> Option<PointResponse> {
+        let r = return_map(e, state, &self.stiffness, m, &self.hardening)?;
         Some(PointResponse { stress: r.stress, tangent: r.tangent, state: r.state, yielding: r.yielding, log_strain: *e })
     }
 
@@ -115,7 +125,7 @@ mod tests {
 
     /// The response to E11 with the other strains found so that the stresses `free` vanish
     /// (Newton on the point's tangent), from `state`; returns (response, strain).
-    fn driven(l: &PlasticLaw, m: &Quadratic, e11: f64, guess: [f64; 6], free: &[usize], state: &PlasticState) -> (PointResponse, [f64; 6]) {
+    fn driven(l: &PlasticLaw, m: &YieldBasis, e11: f64, guess: [f64; 6], free: &[usize], state: &PlasticState) -> (PointResponse, [f64; 6]) {
         let mut e = guess;
         e[0] = e11;
         for _ in 0..50 {

@@ -4,7 +4,7 @@
 
 use super::law::{PlasticLaw, Plasticity};
 use super::return_map::PlasticState;
-use super::yield_function::Quadratic;
+use super::return_map::YieldBasis;
 use stamp::Result;
 
 /// The plastic layers of a section and the history of their points.
@@ -24,7 +24,7 @@ pub struct PlasticPoints {
 /// the element's converged states.
 pub struct ElementPlasticity<'a> {
     pub laws: &'a [Option<PlasticLaw>],
-    pub quadratics: &'a [Quadratic],
+    pub quadratics: &'a [YieldBasis],
     pub committed: &'a [PlasticState],
     pub finite: bool,
 }
@@ -43,10 +43,14 @@ impl PlasticPoints {
         &self.states[e * n..(e + 1) * n]
     }
 
-    /// The yield functions of the layers in a frame turned by `angle` from the plate's axes
-    /// (identity matrices stand for the elastic layers).
-    pub fn quadratics(&self, angle: f64) -> Vec<Quadratic> {
-        self.laws.iter().map(|l| l.as_ref().map(|l| l.quadratic_in(angle)).unwrap_or([[0.0; 6]; 6])).collect()
+    /// The yield functions of the layers in a frame turned by `angle` from the plate's axes, into
+    /// `out` (one per law; the elastic layers' entries are not read).
+    pub fn quadratics_into(&self, angle: f64, out: &mut Vec<YieldBasis>) {
+        out.clear();
+        out.extend(self.laws.iter().map(|l| match l {
+            Some(l) => l.quadratic_in(angle),
+            None => YieldBasis { m: [[0.0; 6]; 6], v: [[0.0; 6]; 6], omega: [0.0; 6] },
+        }));
     }
 }
 
@@ -54,8 +58,8 @@ impl ElementPlasticity<'_> {
     /// S and dS/dE at strain `e` of the point `point` (level q, Gauss point g: 4 q + g) of law
     /// `law`, None if that law is elastic; Some(None) when I + 2E is not positive definite.
     #[inline]
-    pub fn respond(&self, law: usize, point: usize, e: &[f64; 6]) -> Option<Option<super::law::PointResponse>> {
+    pub fn respond(&self, law: usize, point: usize, e: &[f64; 6], with_tangent: bool) -> Option<Option<super::law::PointResponse>> {
         let l = self.laws.get(law)?.as_ref()?;
-        Some(if self.finite { l.respond(e, &self.committed[point], &self.quadratics[law]) } else { l.respond_small(e, &self.committed[point], &self.quadratics[law]) })
+        Some(if self.finite { l.respond_with(e, &self.committed[point], &self.quadratics[law], with_tangent) } else { l.respond_small(e, &self.committed[point], &self.quadratics[law]) })
     }
 }

@@ -7,16 +7,17 @@
 //!
 //! Backward Euler from the last converged (Hp_n, ep_n): T = (C^-1 + dlambda M)^-1 (H - Hp_n), and
 //! the one unknown dlambda >= 0 solves g(dlambda) = phi(T) - sigma_y(ep_n + dlambda phi(T)) = 0
-//! (Newton safeguarded by bisection). The consistent tangent dT/dH is the 6 x 6 block of the
-//! inverse Jacobian of the local equations [C^-1 T + dlambda M T - (H - Hp_n), g] in (T, dlambda)
-//! (implicit differentiation), so that the plate's Newton iteration stays quadratic.
+//! (Newton safeguarded by bisection), in the generalised eigenbasis of M and C^-1
+//! ([`YieldBasis`]) where T(dlambda) is explicit. The consistent tangent dT/dH comes from
+//! differentiating the local equations [C^-1 T + dlambda M T - (H - Hp_n), g] in (T, dlambda):
+//! dT/dH = Xi - c (Xi n)(Xi n)^T / (c n . Xi n + sigma_y'), Xi = (C^-1 + dlambda M)^-1,
+//! n = M T / phi, c = 1 - sigma_y' dlambda, so that the plate's Newton iteration stays quadratic.
 
 use super::hardening::Hardening;
 use super::yield_function::Quadratic;
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
 type M6 = SMatrix<f64, 6, 6>;
-type V6 = SVector<f64, 6>;
 
 /// The converged state of a material point: the plastic strain Hp (Voigt, engineering shears) and
 /// the equivalent plastic strain ep.
@@ -51,55 +52,86 @@ fn m6(a: &[[f64; 6]; 6]) -> M6 {
     M6::from_fn(|i, j| a[i][j])
 }
 
-/// The return map at strain `h` from the converged `state` (see the module doc). `compliance` is
-/// C^-1 of the elastic stiffness `stiffness`. None for a strain that is not finite or a return
+/// A yield function with the elastic compliance in one basis: the generalised eigenvectors
+/// M v_i = omega_i C^-1 v_i, normalised v_i . C^-1 v_j = delta_ij, so that
+/// (C^-1 + dlambda M)^-1 = sum_i v_i v_i^T / (1 + dlambda omega_i): the return map then solves its
+/// scalar equation without a linear solve. Made once per law and frame (an element's).
+#[derive(Debug, Clone, Copy)]
+pub struct YieldBasis {
+    pub m: Quadratic,
+    /// v[i] the i-th generalised eigenvector.
+    pub v: [[f64; 6]; 6],
+    pub omega: [f64; 6],
+}
+
+impl YieldBasis {
+    /// The basis of `m` with the compliance `compliance` (symmetric positive definite).
+    pub fn new(m: &Quadratic, compliance: &[[f64; 6]; 6]) -> YieldBasis {
+        let s = m6(compliance);
+        let l = s.cholesky().expect("the compliance is positive definite").l();
+        let li = l.try_inverse().expect("regular");
+        let b = li * m6(m) * li.transpose();
+        let b = (b + b.transpose()) * 0.5;
+        let eig = nalgebra::SymmetricEigen::new(b);
+        let vm = li.transpose() * eig.eigenvectors;
+        YieldBasis { m: *m, v: std::array::from_fn(|i| std::array::from_fn(|k| vm[(k, i)])), omega: std::array::from_fn(|i| eig.eigenvalues[i].max(0.0)) }
+    }
+}
+
+/// The return map at strain `h` from the converged `state` (see the module doc), with the elastic
+/// `stiffness` and the yield function in `basis`. None for a strain that is not finite or a return
 /// that fails (the state is then refused, and Newton backs off).
-pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6], compliance: &[[f64; 6]; 6], m: &Quadratic, hardening: &Hardening) -> Option<Response> {
+pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6], basis: &YieldBasis, hardening: &Hardening) -> Option<Response> {
     if !h.iter().all(|x| x.is_finite()) {
         return None;
     }
-    let c = m6(stiffness);
-    let s = m6(compliance);
-    let mq = m6(m);
-    let e = V6::from_fn(|i, _| h[i] - state.hp[i]);
-    let trial = c * e;
-    let phi_of = |t: &V6| t.dot(&(mq * t)).max(0.0).sqrt();
-    let phi_tr = phi_of(&trial);
+    let e: [f64; 6] = std::array::from_fn(|i| h[i] - state.hp[i]);
+    // the components of e in the basis: a_i = v_i . e (T = sum_i v_i a_i / (1 + dl omega_i))
+    let a: [f64; 6] = std::array::from_fn(|i| (0..6).map(|k| basis.v[i][k] * e[k]).sum());
+    let om = &basis.omega;
+    // phi(dl) and d phi / d dl
+    let phi_at = |dl: f64| -> (f64, f64) {
+        let (mut p2, mut d) = (0.0, 0.0);
+        for i in 0..6 {
+            let q = 1.0 / (1.0 + dl * om[i]);
+            let w = om[i] * a[i] * a[i] * q * q;
+            p2 += w;
+            d -= 2.0 * w * om[i] * q;
+        }
+        let phi = p2.max(0.0).sqrt();
+        (phi, if phi > 0.0 { 0.5 * d / phi } else { 0.0 })
+    };
+    let (phi_tr, _) = phi_at(0.0);
     let (sy0, _) = hardening.yield_stress(state.ep);
     if phi_tr <= sy0 {
-        return Some(Response { stress: trial.into(), tangent: *stiffness, state: *state, yielding: false });
+        let stress = std::array::from_fn(|i| (0..6).map(|j| stiffness[i][j] * e[j]).sum());
+        return Some(Response { stress, tangent: *stiffness, state: *state, yielding: false });
     }
-    // T(dlambda) and g(dlambda), with dg/ddlambda
-    let at = |dl: f64| -> Option<(V6, f64, f64, f64)> {
-        let a = s + mq * dl;
-        let lu = a.lu();
-        let t = lu.solve(&e)?;
-        let mt = mq * t;
-        let phi = t.dot(&mt).max(0.0).sqrt();
-        let dt = -lu.solve(&mt)?;
-        let dphi = if phi > 0.0 { mt.dot(&dt) / phi } else { 0.0 };
+    let g_at = |dl: f64| -> (f64, f64, f64) {
+        let (phi, dphi) = phi_at(dl);
         let (sy, hs) = hardening.yield_stress(state.ep + dl * phi);
-        let g = phi - sy;
-        let dg = dphi - hs * (phi + dl * dphi);
-        g.is_finite().then_some((t, phi, g, dg))
+        (phi, phi - sy, dphi - hs * (phi + dl * dphi))
     };
-    // a bracket [lo, hi] with g(lo) > 0 > g(hi): von Mises' radial return as the first guess
-    let mu3 = 3.0 * c[(3, 3)];
+    // a bracket [lo, hi] with g(lo) > 0 >= g(hi), from von Mises' radial return's dlambda
+    let omax = om.iter().cloned().fold(0.0, f64::max);
     let mut lo = 0.0;
-    let mut hi = (phi_tr / sy0 - 1.0) / mu3.max(f64::MIN_POSITIVE);
+    let mut hi = (phi_tr / sy0 - 1.0) / omax.max(f64::MIN_POSITIVE);
     let mut tries = 0;
-    while at(hi)?.2 > 0.0 {
+    while g_at(hi).1 > 0.0 {
         lo = hi;
         hi *= 4.0;
         tries += 1;
-        if tries > 200 {
+        if tries > 200 || !hi.is_finite() {
             return None;
         }
     }
     let mut dl = hi;
-    let mut result = at(dl)?;
-    for _ in 0..100 {
-        let (_, phi, g, dg) = result;
+    let mut r = g_at(dl);
+    for _ in 0..200 {
+        let (phi, g, dg) = r;
+        if !g.is_finite() {
+            return None;
+        }
         if g.abs() <= 1e-13 * phi.max(sy0) {
             break;
         }
@@ -110,23 +142,28 @@ pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6],
         }
         let newton = dl - g / dg;
         dl = if dg < 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
-        result = at(dl)?;
+        r = g_at(dl);
         if hi - lo <= 1e-16 * hi {
             break;
         }
     }
-    let (t, phi, _, _) = result;
+    let (phi, _, _) = r;
     let (_, hs) = hardening.yield_stress(state.ep + dl * phi);
-    let mt = mq * t;
-    // the local Jacobian in (T, dlambda) and its inverse's T block: dT/dH
-    let mut j = SMatrix::<f64, 7, 7>::zeros();
-    j.fixed_view_mut::<6, 6>(0, 0).copy_from(&(s + mq * dl));
-    j.fixed_view_mut::<6, 1>(0, 6).copy_from(&mt);
-    let n = mt / phi;
-    j.fixed_view_mut::<1, 6>(6, 0).copy_from(&(n.transpose() * (1.0 - hs * dl)));
-    j[(6, 6)] = -hs * phi;
-    let inv = j.try_inverse()?;
-    let tangent: [[f64; 6]; 6] = std::array::from_fn(|a| std::array::from_fn(|b| inv[(a, b)]));
+    // T, Xi = (C^-1 + dl M)^-1 and n = M T / phi
+    let q: [f64; 6] = std::array::from_fn(|i| 1.0 / (1.0 + dl * om[i]));
+    let t: [f64; 6] = std::array::from_fn(|k| (0..6).map(|i| basis.v[i][k] * a[i] * q[i]).sum());
+    let mt: [f64; 6] = std::array::from_fn(|i| (0..6).map(|j| basis.m[i][j] * t[j]).sum());
+    let xi: [[f64; 6]; 6] = std::array::from_fn(|k| std::array::from_fn(|l| (0..6).map(|i| basis.v[i][k] * q[i] * basis.v[i][l]).sum()));
+    let n: [f64; 6] = std::array::from_fn(|i| mt[i] / phi);
+    let xn: [f64; 6] = std::array::from_fn(|i| (0..6).map(|j| xi[i][j] * n[j]).sum());
+    // dT/dH = Xi - c (Xi n)(Xi n)^T / (c n.Xi n + sigma_y'), c = 1 - sigma_y' dl (implicit
+    // differentiation of the local equations, see the module doc)
+    let c = 1.0 - hs * dl;
+    let den = c * (0..6).map(|i| n[i] * xn[i]).sum::<f64>() + hs;
+    if !(den.abs() > 0.0) {
+        return None;
+    }
+    let tangent = std::array::from_fn(|i| std::array::from_fn(|j| xi[i][j] - c * xn[i] * xn[j] / den));
     let hp = std::array::from_fn(|i| state.hp[i] + dl * mt[i]);
-    Some(Response { stress: t.into(), tangent, state: PlasticState { hp, ep: state.ep + dl * phi }, yielding: true })
+    Some(Response { stress: t, tangent, state: PlasticState { hp, ep: state.ep + dl * phi }, yielding: true })
 }
