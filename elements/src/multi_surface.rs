@@ -333,17 +333,21 @@ impl<const N: usize, const P: usize, const D: usize> MultiSurfacePlate<N, P, D> 
         Some(ElementPlasticity { laws: &p.laws, quadratics, committed: p.of_element(e), finite: p.finite })
     }
 
-    /// The equivalent plastic strain and whether the point yields (last converged step) at `x3`
-    /// from the middle of the section at the four Gauss points of element `e`: the converged
-    /// states of the layer's levels interpolated through its thickness (a polynomial through its
-    /// N levels, extrapolated to its faces), the return map from there at the element's strain
-    /// at `x3`, so that the stresses of [`MultiSurfacePlate::stresses_at`] lie on or inside the
-    /// yield surface. Zeros for an elastic plate or layer.
-    pub fn plastic_strain_at(&self, e: usize, x3: f64, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>) -> [(f64, bool); 4] {
-        match self.plastic_point_at(e, x3, v, ws) {
-            Some(r) => r.map(|r| (r.state.ep, r.yielding)),
-            None => [(0.0, false); 4],
-        }
+    /// The equivalent plastic strain and the yield state (whether it flowed in the last converged
+    /// step) at `x3` from the middle of the section at the four Gauss points of element `e`: the
+    /// converged states of the layer's levels interpolated through its thickness (a polynomial
+    /// through its N levels, extrapolated to its faces), the return map from there at the
+    /// element's strain at `x3`, so that the stresses of [`MultiSurfacePlate::stresses_at`] lie on
+    /// or inside the yield surface; the yield state is the nearest level's. None for an elastic
+    /// plate or layer.
+    pub fn plastic_strain_at(&self, e: usize, x3: f64, v: &[f64], ws: &mut MultiSurfaceWorkspace<P, D>) -> Option<[(f64, bool); 4]> {
+        let r = self.plastic_point_at(e, x3, v, ws)?;
+        let p = self.plastic.as_ref()?;
+        let states = p.of_element(e);
+        let mid = 0.5 * (self.section.delta_minus + self.section.delta_plus);
+        let k = self.section.layers.iter().rposition(|l| x3 + mid >= l.bottom).unwrap_or(0);
+        let nearest = (0..self.levels.len()).filter(|&q| self.levels[q].law == k).min_by(|&a, &b| (self.levels[a].x3 - x3).abs().total_cmp(&(self.levels[b].x3 - x3).abs()))?;
+        Some(std::array::from_fn(|g| (r[g].state.ep, states[4 * nearest + g].active)))
     }
 
     /// The plastic answer at `x3` (see [`MultiSurfacePlate::plastic_strain_at`]), None where the

@@ -255,7 +255,7 @@ mod tests {
             Plasticity { hardening: Hardening::Swift { k: 530.0, e0: 0.005, n: 0.25 }, r_values: Some([1.8, 1.4, 2.2]) },
             Plasticity { hardening: Hardening::Table(vec![(0.0, 150.0), (0.1, 260.0), (0.3, 300.0)]), r_values: Some([0.8, 1.2, 1.0]) },
         ];
-        let committed = PlasticState { hp: [0.01, -0.004, -0.006, 0.002, 0.0, 0.003], ep: 0.012 };
+        let committed = PlasticState { hp: [0.01, -0.004, -0.006, 0.002, 0.0, 0.003], ep: 0.012, active: true };
         for p in &cases {
             let l = law(p);
             let m = l.quadratic_in(0.3);

@@ -25,6 +25,8 @@ type M6 = SMatrix<f64, 6, 6>;
 pub struct PlasticState {
     pub hp: [f64; 6],
     pub ep: f64,
+    /// Whether the point flowed plastically in the step that made this state (the yield state).
+    pub active: bool,
 }
 
 /// The stress, the consistent tangent dT/dH, the new state and whether the point yields.
@@ -105,7 +107,7 @@ pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6],
     let (sy0, _) = hardening.yield_stress(state.ep);
     if phi_tr <= sy0 {
         let stress = std::array::from_fn(|i| (0..6).map(|j| stiffness[i][j] * e[j]).sum());
-        return Some(Response { stress, tangent: *stiffness, state: *state, yielding: false });
+        return Some(Response { stress, tangent: *stiffness, state: PlasticState { active: false, ..*state }, yielding: false });
     }
     let g_at = |dl: f64| -> (f64, f64, f64) {
         let (phi, dphi) = phi_at(dl);
@@ -165,5 +167,5 @@ pub fn return_map(h: &[f64; 6], state: &PlasticState, stiffness: &[[f64; 6]; 6],
     }
     let tangent = std::array::from_fn(|i| std::array::from_fn(|j| xi[i][j] - c * xn[i] * xn[j] / den));
     let hp = std::array::from_fn(|i| state.hp[i] + dl * mt[i]);
-    Some(Response { stress: t, tangent, state: PlasticState { hp, ep: state.ep + dl * phi }, yielding: true })
+    Some(Response { stress: t, tangent, state: PlasticState { hp, ep: state.ep + dl * phi, active: true }, yielding: true })
 }

@@ -151,6 +151,16 @@ impl Plate {
             _ => None,
         }
     }
+    /// The equivalent plastic strain and the yield state at height `x3` (from the mid-plane) of
+    /// element `e` at its four Gauss points; None for an elastic plate.
+    pub fn plastic_strain_at(&self, e: usize, x3: f64, v: &[f64], ws: &mut PlateWs) -> Option<[(f64, bool); 4]> {
+        match (self, ws) {
+            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.plastic_strain_at(e, x3, v, w),
+            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.plastic_strain_at(e, x3, v, w),
+            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.plastic_strain_at(e, x3, v, w),
+            _ => None,
+        }
+    }
     /// Surfaces through the thickness.
     pub fn surfaces(&self) -> usize {
         Element::dofs_per_node(self) / 3
