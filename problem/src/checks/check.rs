@@ -660,6 +660,7 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
             "plate: {}, thickness {} (x3 from {} to {}), E = {}, nu = {}, {}{}{}{}",
             match setup.model.element.surfaces() {
                 2 => "two surfaces (the paper's plate)".to_string(),
+                n if setup.model.element.is_plastic() => format!("{n} surfaces (displacement of degree {} through the thickness, 3D law), elastic-plastic", n - 1),
                 n => format!("{n} surfaces (displacement of degree {} through the thickness, 3D law)", n - 1),
             },
             num(setup.section.thickness()),

@@ -315,7 +315,7 @@ mod tests {
         let mut h = History::new(&[(name.into(), Face::Top, false)], &[]);
         for (k, &(t, travel)) in steps.iter().enumerate() {
             let punches = vec![PunchRow { travel, force: 10.0 * t, contact_area: 1.0, max_pressure: 1.0, max_penetration: 0.0, force_on_punch: [0.0; 3], dissipation: None }];
-            h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0, supports: vec![] });
+            h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0, supports: vec![], plastic: None });
         }
         let dir = std::env::temp_dir().join(format!("stamp-history-plot-{}-{name}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
