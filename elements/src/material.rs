@@ -44,10 +44,10 @@ impl Isotropic {
     /// Check E > 0 and -1 < nu < 0.5.
     pub fn validate(&self) -> Result<()> {
         if !(self.young.is_finite() && self.young > 0.0) {
-            return Err(StampError::Material(format!("Young's modulus must be positive and finite, got {}", self.young)));
+            return Err(StampError::Material(format!("Young's modulus must be positive and finite, got {}", crate::plasticity::short(self.young))));
         }
         if !(self.poisson > -1.0 && self.poisson < 0.5) {
-            return Err(StampError::Material(format!("Poisson's ratio must lie in (-1, 0.5), got {}", self.poisson)));
+            return Err(StampError::Material(format!("Poisson's ratio must lie in (-1, 0.5), got {}", crate::plasticity::short(self.poisson))));
         }
         Ok(())
     }

@@ -1,5 +1,6 @@
 //! Isotropic hardening: the yield stress as a function of the equivalent plastic strain ep.
 
+use super::short;
 use stamp::{Result, StampError};
 
 /// sigma_y(ep), ep the equivalent plastic strain (the work conjugate of the yield function's
@@ -22,21 +23,21 @@ impl Hardening {
         match self {
             Hardening::Linear { yield_stress, modulus } => {
                 if !(yield_stress.is_finite() && *yield_stress > 0.0) {
-                    return bad(format!("the initial yield stress must be positive and finite, got {yield_stress}"));
+                    return bad(format!("the initial yield stress must be positive and finite, got {}", short(*yield_stress)));
                 }
                 if !(modulus.is_finite() && *modulus >= 0.0) {
-                    return bad(format!("the hardening modulus H must be >= 0 and finite (softening is not supported), got {modulus}"));
+                    return bad(format!("the hardening modulus H must be >= 0 and finite (softening is not supported), got {}", short(*modulus)));
                 }
             }
             Hardening::Swift { k, e0, n } => {
                 if !(k.is_finite() && *k > 0.0) {
-                    return bad(format!("Swift's K must be positive and finite, got {k}"));
+                    return bad(format!("Swift's K must be positive and finite, got {}", short(*k)));
                 }
                 if !(e0.is_finite() && *e0 > 0.0) {
-                    return bad(format!("Swift's e0 must be positive (sigma_y(0) = K e0^n is the initial yield stress), got {e0}"));
+                    return bad(format!("Swift's e0 must be positive (sigma_y(0) = K e0^n is the initial yield stress), got {}", short(*e0)));
                 }
                 if !(n.is_finite() && (0.0..=1.0).contains(n)) {
-                    return bad(format!("Swift's exponent n must lie in [0, 1], got {n}"));
+                    return bad(format!("Swift's exponent n must lie in [0, 1], got {}", short(*n)));
                 }
             }
             Hardening::Table(rows) => {
@@ -44,19 +45,19 @@ impl Hardening {
                     return bad("the hardening table needs at least one row [plastic strain, yield stress]".into());
                 }
                 if rows[0].0 != 0.0 {
-                    return bad(format!("the hardening table's first row must be at plastic strain 0 (the initial yield stress), got {}", rows[0].0));
+                    return bad(format!("the hardening table's first row must be at plastic strain 0 (the initial yield stress), got {}", short(rows[0].0)));
                 }
                 for (i, &(e, s)) in rows.iter().enumerate() {
                     if !(e.is_finite() && s.is_finite() && s > 0.0) {
-                        return bad(format!("row {i} of the hardening table: expected a finite plastic strain and a positive yield stress, got [{e}, {s}]"));
+                        return bad(format!("row {i} of the hardening table: expected a finite plastic strain and a positive yield stress, got [{}, {}]", short(e), short(s)));
                     }
                     if i > 0 {
                         let (ep, sp) = rows[i - 1];
                         if e <= ep {
-                            return bad(format!("row {i} of the hardening table: the plastic strains must increase, got {e} after {ep}"));
+                            return bad(format!("row {i} of the hardening table: the plastic strains must increase, got {} after {}", short(e), short(ep)));
                         }
                         if s < sp {
-                            return bad(format!("row {i} of the hardening table: the yield stress must not decrease (softening is not supported), got {s} after {sp}"));
+                            return bad(format!("row {i} of the hardening table: the yield stress must not decrease (softening is not supported), got {} after {}", short(s), short(sp)));
                         }
                     }
                 }

@@ -20,3 +20,13 @@ pub use hardening::Hardening;
 pub use law::{Plasticity, PlasticLaw};
 pub use return_map::PlasticState;
 pub use points::{ElementPlasticity, PlasticPoints};
+
+/// A number for a message: as written between 1e-4 and 1e7, in exponent form otherwise (an
+/// extreme value read from a file stays a short line).
+pub(crate) fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e7).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

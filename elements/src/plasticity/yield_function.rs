@@ -22,7 +22,7 @@ pub fn von_mises() -> Quadratic {
 /// M of Hill's 1948 function from the r-values [r0, r45, r90] in the sheet's axes.
 pub fn hill(r: [f64; 3]) -> Result<Quadratic> {
     if let Some(bad) = r.iter().find(|x| !(x.is_finite() && **x > 0.0 && **x <= 100.0)) {
-        return Err(StampError::Material(format!("the r-values [r0, r45, r90] must be positive (Lankford coefficients, 0.1 to 10 in practice), got {bad}")));
+        return Err(StampError::Material(format!("the r-values [r0, r45, r90] must be positive (Lankford coefficients, 0.1 to 10 in practice), got {}", super::short(*bad))));
     }
     let [r0, r45, r90] = r;
     let h = r0 / (1.0 + r0);

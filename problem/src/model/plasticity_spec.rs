@@ -14,6 +14,7 @@
 //! surfaces = 5
 //! ```
 
+use crate::schema::limits::{MAX_MAGNITUDE, MIN_MAGNITUDE};
 use crate::schema::{num, PlasticitySpec, Problem};
 use stamp::Result;
 use stamp_elements::plasticity::{Hardening, Plasticity};
@@ -106,6 +107,23 @@ pub fn plasticity(p: &Problem, i: usize, spec: &PlasticitySpec) -> Result<Plasti
         }
         other => return Err(err(".hardening", format!("unknown hardening \"{}\": expected \"linear\" (yield, H), \"swift\" (K, e0, n) or \"table\" (table)", stamp::quote(other)))),
     };
+    // the magnitudes of [plate]'s E (a stress of 1e-300 or 1e300 is a typing error, and ends in
+    // overflow or a state that never yields)
+    let stresses: Vec<(&str, f64)> = match &hardening {
+        Hardening::Linear { yield_stress, .. } => vec![("yield", *yield_stress)],
+        Hardening::Swift { k, .. } => vec![("K", *k)],
+        Hardening::Table(rows) => rows.iter().map(|r| ("table", r.1)).collect(),
+    };
+    for (k, v) in stresses {
+        if v > 0.0 && !(MIN_MAGNITUDE..=MAX_MAGNITUDE).contains(&v) {
+            return Err(err(&format!(".{k}"), format!("expected a stress from {MIN_MAGNITUDE:e} to {MAX_MAGNITUDE:e} (the range of [plate] E), got {}", num(v))));
+        }
+    }
+    if let Hardening::Linear { modulus, .. } = &hardening {
+        if *modulus > MAX_MAGNITUDE {
+            return Err(err(".H", format!("expected a modulus up to {MAX_MAGNITUDE:e}, got {}", num(*modulus))));
+        }
+    }
     let plasticity = Plasticity { hardening, r_values: spec.r };
     plasticity.validate().map_err(|e| err(if e.to_string().contains("r-values") { ".r" } else { "" }, e.to_string().trim_start_matches("material: ").to_string()))?;
     Ok(plasticity)
