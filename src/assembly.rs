@@ -155,6 +155,11 @@ impl Assembler {
         self.order.len()
     }
 
+    /// The elements this assembler evaluates, in its order.
+    pub fn elements(&self) -> &[usize] {
+        &self.order
+    }
+
     /// Number of colours of the blocks (for diagnostics).
     pub fn num_colors(&self) -> usize {
         self.colors.len()

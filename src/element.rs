@@ -95,4 +95,14 @@ pub trait Element: Sync {
     fn evaluate_about(&self, e: usize, u: &[f64], _reference: &[f64], ws: &mut Self::Workspace, out: &mut LocalSystem, with_tangent: bool) {
         self.evaluate(e, u, ws, out, with_tangent)
     }
+
+    /// Whether the elements carry a history that depends on the load path (plasticity): the
+    /// model then calls [`commit`](Self::commit) on every element it evaluates after each
+    /// converged load step. `evaluate` reads the history of the last converged step only, so that a
+    /// failed step, cut back, leaves nothing to undo. Default: no history.
+    fn has_history(&self) -> bool {
+        false
+    }
+    /// Make the state at the local dof values `u` (a converged step's) element `e`'s history.
+    fn commit(&mut self, _e: usize, _u: &[f64], _ws: &mut Self::Workspace) {}
 }

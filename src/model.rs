@@ -472,6 +472,35 @@ fn owns_row(share: &Option<Share>, dofs_per_node: usize, nd: usize) -> impl Fn(u
     }
 }
 
+impl<E: Element> Model<E> {
+    /// [`Element::commit`] on every element this model evaluates, at the last evaluation's state
+    /// (the last evaluation is the whole model's on every process: see [`crate::share`]).
+    fn commit_elements(&mut self) {
+        if !self.element.has_history() || self.last_u.is_empty() {
+            return;
+        }
+        let dpn = self.dofs.dofs_per_node();
+        let mut ws = self.element.new_workspace();
+        let mut local = vec![0.0; dpn * self.element.nodes_per_element()];
+        // the process that writes the outputs (a share's leader, which keeps every element)
+        // commits every element, so that it writes every point's state; the others their own
+        let every: Vec<usize>;
+        let elements = match &self.share {
+            Some(s) if s.leader => {
+                every = (0..self.element.num_elements()).collect();
+                &every[..]
+            }
+            _ => self.assembler.elements(),
+        };
+        for &e in elements {
+            for (a, &n) in self.element.element_nodes(e).iter().enumerate() {
+                local[a * dpn..(a + 1) * dpn].copy_from_slice(&self.last_u[n * dpn..(n + 1) * dpn]);
+            }
+            self.element.commit(e, &local, &mut ws);
+        }
+    }
+}
+
 impl<E: Element> NonlinearProblem for Model<E> {
     fn num_dofs(&self) -> usize {
         self.dofs.num_dofs() + self.num_drives()
@@ -764,11 +793,19 @@ impl<E: Element> NonlinearProblem for Model<E> {
     fn end_step(&mut self, _u: &[f64], _t: f64) -> bool {
         self.augment_violated()
     }
+    fn path_corners(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = self.contacts.iter().flat_map(|c| c.motion.corners().into_iter().chain(c.rotation.iter().flat_map(|r| r.corners()))).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    }
     fn checkpoint(&mut self) {
         // called after a converged step (and once before the first): its last evaluation is the
         // converged state's
         self.peak_scale = self.peak_scale.max(self.last_scale);
         self.converged_u.clone_from(&self.last_u);
+        // path-dependent elements (plasticity): the converged state becomes their history
+        self.commit_elements();
         // with a share: every point's state whole on every process (the outputs read it)
         for c in self.contacts.iter_mut() {
             if let Err(e) = c.gather_state() {

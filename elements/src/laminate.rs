@@ -246,7 +246,7 @@ impl<const N: usize, const P: usize, const D: usize> LaminatePlate<N, P, D> {
         for (k, ply) in self.plies.iter().enumerate() {
             Self::gather(ply, v, &mut ws.v);
             ws.laws[0] = self.law(e, k);
-            resultants_of(&self.geometry[e], &ply.levels, &ws.laws, self.kinematics, &ws.v, &mut ws.inner, &mut r);
+            resultants_of(&self.geometry[e], &ply.levels, &ws.laws, None, self.kinematics, &ws.v, &mut ws.inner, &mut r);
         }
         r
     }
@@ -335,7 +335,7 @@ impl<const N: usize, const P: usize, const D: usize> LaminatePlate<N, P, D> {
             }
             let LaminateWorkspace { inner, v: vl, v_ref, residual, tangent, laws } = ws;
             let reference = reference.map(|_| &v_ref[..]);
-            evaluate_levels(&self.geometry[e], &ply.levels, laws, self.kinematics, vl, reference, inner, residual, tangent, &mut out.energy, with_tangent);
+            evaluate_levels(&self.geometry[e], &ply.levels, laws, self.kinematics, vl, reference, None, inner, residual, tangent, &mut out.energy, with_tangent);
             ratio = ratio.min(inner.volume_ratio);
             for (i, &di) in ply.dofs.iter().enumerate() {
                 out.residual[di] += residual[i];

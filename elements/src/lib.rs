@@ -14,6 +14,7 @@ pub mod plate;
 pub mod strain;
 pub mod multi_surface;
 pub mod orthotropic;
+pub mod plasticity;
 pub mod laminate;
 
 pub use follower::{fixed_couple_force, FollowerCouple, FollowerPressure};

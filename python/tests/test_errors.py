@@ -232,3 +232,17 @@ def test_a_group_named_like_a_gmsh_number_is_refused_not_dropped():
     t["mesh"] = {"nodes": xy, "cells": cells, "groups": {"#1": {"nodes": [0]}}}
     m = raised(t)
     assert "mesh.groups.#1: a group's name cannot start with '#'" in m, m
+
+
+def test_a_plasticity_dict_with_a_bad_key_is_refused_naming_it():
+    t = table()
+    del t["plate"]["E"], t["plate"]["nu"]
+    t["plate"]["material"] = "steel"
+    t["plate"]["surfaces"] = 3
+    t["material"] = [{"name": "steel", "E": 2.1e5, "nu": 0.3, "plasticity": {"yield": 250.0, "K": 500.0}}]
+    assert 'material[0].plasticity.K: does not belong to hardening = "linear"' in raised(t)
+    t["material"][0]["plasticity"] = {"hardening": "swift", "K": 530.0, "n": 0.25}
+    assert "material[0].plasticity: missing `e0`" in raised(t)
+    t["plate"]["surfaces"] = 2
+    t["material"][0]["plasticity"] = {"yield": 250.0}
+    assert "plate.surfaces" in raised(t)

@@ -10,7 +10,7 @@ from conftest import MESHES, assert_same_history, read_history, run_cli
 
 # quick ones: rectangle and gmsh meshes (quadrilaterals; triangles cut), two to four surfaces,
 # force- and displacement-driven punches, two punches, friction, a punch that turns
-EXAMPLES = ["sphere-ss", "squeeze", "paper-r100", "disk-clamped", "sphere-ss-4surfaces", "stl-die", "sphere-slide-friction", "cylinder-rolling-friction"]
+EXAMPLES = ["sphere-ss", "squeeze", "paper-r100", "disk-clamped", "sphere-ss-4surfaces", "stl-die", "sphere-slide-friction", "cylinder-rolling-friction", "sphere-dent-plastic"]
 
 
 @pytest.fixture(scope="module", params=EXAMPLES)

@@ -50,6 +50,29 @@ impl Default for PunchMotion {
 }
 
 impl PunchMotion {
+    /// The load factors at which the path turns (its direction changes between two rows): the
+    /// load stepping does not extrapolate a step across them (a punch lifted after pressing would
+    /// be predicted deeper still). None for a linear motion.
+    pub fn corners(&self) -> Vec<f64> {
+        let PunchMotion::Path(points) = self else {
+            return Vec::new();
+        };
+        let unit = |a: &[f64; 3], b: &[f64; 3]| {
+            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if n > 0.0 { d.map(|x| x / n) } else { [0.0; 3] }
+        };
+        let mut out = Vec::new();
+        for k in 1..points.len() {
+            let before = unit(&points[k - 1].1, &points[k].1);
+            let after = if k + 1 < points.len() { unit(&points[k].1, &points[k + 1].1) } else { [0.0; 3] };
+            if before.iter().zip(&after).map(|(a, b)| a * b).sum::<f64>() < 1.0 - 1e-9 {
+                out.push(points[k].0);
+            }
+        }
+        out
+    }
+
     /// A path through `rows` (t, displacement). The rows' t must be finite and strictly
     /// increasing, the first at least 0; when the first t is 0 its displacement must be zero (the
     /// punch starts where its geometry puts it), and when it is above 0 the path starts at (0, 0)

@@ -72,6 +72,14 @@ impl PunchRotation {
         self.pivot
     }
 
+    /// The load factors at which the angular rate changes sign or starts or stops (see
+    /// [`crate::contact::PunchMotion::corners`]).
+    pub fn corners(&self) -> Vec<f64> {
+        let p = &self.path;
+        let sign = |k: usize| if k + 1 < p.len() { (p[k + 1].1 - p[k].1).signum() * ((p[k + 1].1 != p[k].1) as u8 as f64) } else { 0.0 };
+        (1..p.len()).filter(|&k| sign(k - 1) != sign(k)).map(|k| p[k].0).collect()
+    }
+
     /// The rows (t, angle in degrees), starting at (0, 0).
     pub fn rows(&self) -> &[(f64, f64)] {
         &self.path

@@ -106,6 +106,7 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
         let mut dt = (self.settings.initial_increment * first_span).min(self.settings.max_increment);
         // the load factors of the last PACE_WINDOW converged steps (and the start), for max_steps
         let mut recent: std::collections::VecDeque<f64> = std::collections::VecDeque::from([t0]);
+        let corners = p.path_corners();
         p.checkpoint();
         for (ti, &target) in targets.iter().enumerate() {
             if !target.is_finite() {
@@ -131,7 +132,11 @@ impl<L: LinearSolver> NonlinearSolver for NewtonRaphson<L> {
                 secant.clear();
                 if let (true, Some((u_prev, t_prev))) = (self.settings.extrapolate, previous.as_ref()) {
                     let ratio = (step_t - t) / (t - t_prev);
-                    if ratio > 0.0 && ratio.is_finite() {
+                    // not across a corner of the loading (the secant of the segment before it
+                    // points elsewhere: a punch lifted after pressing would start deeper still)
+                    let (lo, hi) = (t_prev.min(step_t), t_prev.max(step_t));
+                    let turns = corners.iter().any(|&c| c > lo && c < hi);
+                    if ratio > 0.0 && ratio.is_finite() && !turns {
                         secant.extend(u.iter().zip(u_prev).map(|(a, b)| ratio * (a - b)));
                         for (x, d) in trial.iter_mut().zip(&secant) {
                             *x += theta * d;

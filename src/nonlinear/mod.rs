@@ -100,6 +100,11 @@ pub trait NonlinearProblem {
     fn update_multipliers(&mut self) -> bool {
         false
     }
+    /// The load factors where the loading turns (a punch's path changes direction): a load step
+    /// is not extrapolated across them. Default: none.
+    fn path_corners(&self) -> Vec<f64> {
+        Vec::new()
+    }
     /// Save the history-dependent state (contact) of the last converged step.
     fn checkpoint(&mut self) {}
     /// Go back to the last checkpoint (after a failed step).

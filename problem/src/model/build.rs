@@ -291,6 +291,7 @@ fn build_plate(p: &Problem, mesh: &MeshData) -> Result<PlateBuild> {
         KinematicsSpec::Linear => Kinematics::Linear,
     };
     let laminate = crate::model::laminate_spec::laminate(p)?;
+    let plate_material = crate::model::plasticity_spec::plate_material(p)?;
     // the section: the plate's (homogeneous), or the laminate's faces and a modulus standing for it
     // (the geometry the loads and punches use; the elements take the laminate itself)
     let (section, young) = match &laminate {
@@ -300,7 +301,8 @@ fn build_plate(p: &Problem, mesh: &MeshData) -> Result<PlateBuild> {
             (Section::homogeneous(lam.thickness(), stand_in).map_err(|e| p.error_at(s.plate.span(), "plate.layers", e))?, young)
         }
         None => {
-            let (young, nu) = (ps.young.expect("checked").0, ps.nu.expect("checked").0);
+            let m = plate_material.as_ref().expect("a plate without layers");
+            let (young, nu) = (m.young, m.poisson);
             let material = Isotropic::new(young, nu).map_err(|e| p.error_at(s.plate.span(), "plate", e))?;
             let (dm, dp) = match ps.thickness {
                 Some(h) => (-0.5 * h.0, 0.5 * h.0),
@@ -330,6 +332,10 @@ fn build_plate(p: &Problem, mesh: &MeshData) -> Result<PlateBuild> {
         None => Plate::new(surfaces, &mesh.mesh, section.clone(), kin),
     }
     .map_err(|e| mesh_error(p, mesh, e))?;
+    let plate = match plate_material.and_then(|m| m.plasticity) {
+        Some(plasticity) => plate.with_plasticity(plasticity).map_err(|e| p.error_at(s.plate.span(), "plate.material", e))?,
+        None => plate,
+    };
     Ok(PlateBuild { plate, section, young, kinematics: kin })
 }
 

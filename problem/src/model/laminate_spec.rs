@@ -20,7 +20,7 @@ use stamp_elements::{Isotropic, Laminate, Orthotropic, Ply, PlyMaterial};
 
 /// The materials by name, each checked (isotropic: numbers E and nu, no G; orthotropic: three E,
 /// G and nu), with errors that name `material[i].key`.
-fn materials(p: &Problem) -> Result<Vec<(String, PlyMaterial)>> {
+pub(crate) fn materials(p: &Problem) -> Result<Vec<(String, PlyMaterial)>> {
     let mut out: Vec<(String, PlyMaterial)> = Vec::new();
     for (i, m) in p.spec.material.iter().enumerate() {
         let spec = m.get_ref();
@@ -74,8 +74,8 @@ pub fn laminate(p: &Problem) -> Result<Option<(Laminate, usize)>> {
     let s = &p.spec;
     let ps = s.plate.get_ref();
     let Some(layers) = &ps.layers else {
-        if let Some(m) = s.material.first() {
-            return Err(p.error_at(m.span(), "material[0]", "a [[material]] is used by [plate] layers, and the plate has none: give `layers`, or E and nu in [plate]"));
+        if let Some(m) = s.material.first().filter(|_| ps.material.is_none()) {
+            return Err(p.error_at(m.span(), "material[0]", "a [[material]] is used by [plate] layers or [plate] material, and the plate names none: give `layers`, or `material` = its name in [plate]"));
         }
         return Ok(None);
     };
@@ -130,6 +130,14 @@ pub fn laminate(p: &Problem) -> Result<Option<(Laminate, usize)>> {
                 format!("no [[material]] is named '{}'; the materials are: {}", stamp::quote(&spec.material), if known.is_empty() { "none".into() } else { known.join(", ") }),
             ));
         };
+        let index = s.material.iter().position(|m| m.get_ref().name == spec.material).expect("found above");
+        if s.material[index].get_ref().plasticity.is_some() {
+            return Err(p.error_at(
+                l.span(),
+                &format!("{key}.material"),
+                format!("'{}' is plastic, and plastic layers are not supported yet: a plastic plate is one material, `[plate] material = \"{}\"` with surfaces = 3 to 5", stamp::quote(&spec.material), stamp::quote(&spec.material)),
+            ));
+        }
         plies.push(Ply { thickness: spec.thickness, material: *material, angle: spec.angle });
     }
     let lam = Laminate::new(plies).map_err(|e| p.error_at(layers.span(), "plate.layers", e))?;

@@ -94,6 +94,23 @@ impl Plate {
             n => return Err(stamp::StampError::Material(format!("a layer has 3 to 5 surfaces, not {n}"))),
         })
     }
+    /// The plate with one `plasticity` for its material (three to five surfaces without layers;
+    /// the others refuse it).
+    pub fn with_plasticity(self, plasticity: stamp_elements::plasticity::Plasticity) -> Result<Plate> {
+        let p = [Some(plasticity)];
+        Ok(match self {
+            Plate::ThreeSurface(e) => Plate::ThreeSurface(e.with_plasticity(&p)?),
+            Plate::FourSurface(e) => Plate::FourSurface(e.with_plasticity(&p)?),
+            Plate::FiveSurface(e) => Plate::FiveSurface(e.with_plasticity(&p)?),
+            _ => return Err(stamp::StampError::Material("plasticity needs a plate of three to five surfaces without layers".into())),
+        })
+    }
+    /// Whether the plate has plastic points.
+    pub fn is_plastic(&self) -> bool {
+        matches!(self, Plate::ThreeSurface(e) if e.plastic_points().is_some())
+            || matches!(self, Plate::FourSurface(e) if e.plastic_points().is_some())
+            || matches!(self, Plate::FiveSurface(e) if e.plastic_points().is_some())
+    }
     /// The laminate and the surfaces in each of its layers, for a layered plate.
     pub fn laminate(&self) -> Option<(&Laminate, usize)> {
         match self {
@@ -131,6 +148,16 @@ impl Plate {
             (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => Some(p.stresses_at(e, x3, v, w)),
             (Plate::FourSurface(p), PlateWs::FourSurface(w)) => Some(p.stresses_at(e, x3, v, w)),
             (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => Some(p.stresses_at(e, x3, v, w)),
+            _ => None,
+        }
+    }
+    /// The equivalent plastic strain and the yield state at height `x3` (from the mid-plane) of
+    /// element `e` at its four Gauss points; None for an elastic plate.
+    pub fn plastic_strain_at(&self, e: usize, x3: f64, v: &[f64], ws: &mut PlateWs) -> Option<[(f64, bool); 4]> {
+        match (self, ws) {
+            (Plate::ThreeSurface(p), PlateWs::ThreeSurface(w)) => p.plastic_strain_at(e, x3, v, w),
+            (Plate::FourSurface(p), PlateWs::FourSurface(w)) => p.plastic_strain_at(e, x3, v, w),
+            (Plate::FiveSurface(p), PlateWs::FiveSurface(w)) => p.plastic_strain_at(e, x3, v, w),
             _ => None,
         }
     }
@@ -299,6 +326,12 @@ impl Element for Plate {
     }
     fn evaluate_about(&self, e: usize, u: &[f64], reference: &[f64], ws: &mut PlateWs, out: &mut LocalSystem, with_tangent: bool) {
         each_with_workspace!(self, ws, (p, w) => p.evaluate_about(e, u, reference, w, out, with_tangent))
+    }
+    fn has_history(&self) -> bool {
+        each!(self, p => p.has_history())
+    }
+    fn commit(&mut self, e: usize, u: &[f64], ws: &mut PlateWs) {
+        each_with_workspace!(self, ws, (p, w) => p.commit(e, u, w))
     }
 }
 

@@ -51,6 +51,8 @@ pub struct HistoryRow {
     pub max_deflection: f64,
     /// The reaction [f1, f2, f3] of each support group ([`History::support_names`]) on the plate.
     pub supports: Vec<[f64; 3]>,
+    /// An elastic-plastic plate: the largest equivalent plastic strain and the least thickness.
+    pub plastic: Option<(f64, f64)>,
 }
 
 /// The direction along which a punch's travel and force are measured.
@@ -138,7 +140,7 @@ impl History {
     /// Add the converged step `step` (unknowns `u`, load factor `t`, path length `path`, the
     /// reactions of the support groups `supports`).
     #[allow(clippy::too_many_arguments)]
-    pub fn record(&mut self, step: usize, t: f64, path: f64, newton_iterations: usize, contacts: &[ContactPair], u: &[f64], supports: Vec<[f64; 3]>) -> &HistoryRow {
+    pub fn record(&mut self, step: usize, t: f64, path: f64, newton_iterations: usize, contacts: &[ContactPair], u: &[f64], supports: Vec<[f64; 3]>, plastic: Option<(f64, f64)>) -> &HistoryRow {
         let punches = contacts.iter().zip(&self.punch_faces).map(|(c, &f)| punch_row(c, f, u, t)).collect();
         let points = self
             .points
@@ -157,7 +159,7 @@ impl History {
         // u holds the surfaces' displacements node by node, then one unknown per force-driven punch
         let nodes = (u.len() - contacts.iter().filter(|c| c.drive.is_some()).count()) / self.layout.dofs_per_node;
         let max_deflection = (0..nodes).map(|n| self.layout.mid_displacement(u, n)[2]).fold(0.0f64, |m, w| if w.abs() > m.abs() { w } else { m });
-        self.rows.push(HistoryRow { step, load_factor: t, path, newton_iterations, punches, points, max_deflection, supports });
+        self.rows.push(HistoryRow { step, load_factor: t, path, newton_iterations, punches, points, max_deflection, supports, plastic });
         self.rows.last().expect("just pushed")
     }
 
@@ -183,6 +185,10 @@ impl History {
         for g in &self.support_names {
             s.push_str(&format!(",{g}_reaction_x1,{g}_reaction_x2,{g}_reaction_x3"));
         }
+        // an elastic-plastic plate: the largest plastic strain and the least thickness
+        if self.rows.first().is_some_and(|r| r.plastic.is_some()) {
+            s.push_str(",max_plastic_strain,min_thickness");
+        }
         s.push('\n');
         for r in &self.rows {
             s.push_str(&format!("{},{:e},{:e}", r.step, r.load_factor, r.path));
@@ -201,6 +207,9 @@ impl History {
             }
             for f in &r.supports {
                 s.push_str(&format!(",{:e},{:e},{:e}", f[0], f[1], f[2]));
+            }
+            if let Some((ep, h)) = r.plastic {
+                s.push_str(&format!(",{ep:e},{h:e}"));
             }
             s.push('\n');
         }
@@ -306,7 +315,7 @@ mod tests {
         let mut h = History::new(&[(name.into(), Face::Top, false)], &[]);
         for (k, &(t, travel)) in steps.iter().enumerate() {
             let punches = vec![PunchRow { travel, force: 10.0 * t, contact_area: 1.0, max_pressure: 1.0, max_penetration: 0.0, force_on_punch: [0.0; 3], dissipation: None }];
-            h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0, supports: vec![] });
+            h.rows.push(HistoryRow { step: k + 1, load_factor: t, path: t, newton_iterations: 2, punches, points: vec![], max_deflection: 0.0, supports: vec![], plastic: None });
         }
         let dir = std::env::temp_dir().join(format!("stamp-history-plot-{}-{name}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -7,6 +7,7 @@
 pub mod equilibrium_shear;
 pub mod history;
 pub mod output;
+pub mod plastic;
 pub mod plot;
 pub mod probe;
 pub mod supports;

@@ -154,6 +154,12 @@ pub struct StepEntry {
     /// The .vtu of this step (relative to the output folder), if written.
     pub vtu: Option<String>,
     pub csv: Vec<String>,
+    /// An elastic-plastic plate: the largest equivalent plastic strain at its surfaces and its
+    /// least thickness (crate::outputs::plastic).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_plastic_strain: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_thickness: Option<f64>,
 }
 
 /// Everything computed for one step.
@@ -186,6 +192,11 @@ pub fn cell_array_names(plate: &Plate) -> Vec<String> {
                 v.push(stress_field_name(k, s));
             }
         }
+    }
+    if plate.is_plastic() {
+        let n = plate.surfaces();
+        v.extend((0..n).map(|s| format!("plastic_strain_surface{s}")));
+        v.extend((0..n).map(|s| format!("yielding_surface{s}")));
     }
     v
 }
@@ -246,6 +257,7 @@ pub fn cell_fields(model: &Model<Plate>, u: &[f64]) -> Vec<Field> {
     }
     let mut fields: Vec<Field> = CELL_ARRAYS.iter().zip(out).map(|(name, v)| Field::scalar(*name, v)).collect();
     fields.extend(layer_stress_fields(model, u));
+    fields.extend(crate::outputs::plastic::plastic_cell_fields(plate, u));
     fields
 }
 
@@ -388,6 +400,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
     point_fields.push(Field::scalar("active", active.clone()));
     point_fields.push(Field::scalar("loaded", loaded.clone()));
     point_fields.extend(friction_fields);
+    point_fields.extend(crate::outputs::plastic::plastic_point_fields(&model.element, u, cx.mesh.mesh.num_nodes()));
     let points = cx
         .point_groups
         .iter()
@@ -435,6 +448,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
             support[(d % dpn) % 3] -= f;
         }
     }
+    let plastic = crate::outputs::plastic::plastic_extremes(&model.element, u, cx.mesh.mesh.num_nodes());
     let entry = StepEntry {
         step: report.step,
         load_factor: t,
@@ -457,6 +471,8 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         punches,
         vtu: None,
         csv: Vec::new(),
+        max_plastic_strain: plastic.map(|p| p.0),
+        min_thickness: plastic.map(|p| p.1),
     };
     StepData { entry, point_fields, cell_fields: cell_fields(model, u), punch_rows }
 }

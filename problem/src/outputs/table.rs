@@ -94,6 +94,7 @@ mod tests {
                 points: vec![],
                 max_deflection: -0.1 * t,
                 supports: vec![],
+                plastic: None,
             });
         }
         let units = Units { length: "mm".into(), force: "N".into(), pressure: "MPa".into(), area: "mm^2".into(), length_given: true, force_given: true };

@@ -278,6 +278,7 @@ mod tests {
                 points: vec![[0.0, 0.0, w]],
                 max_deflection: w,
                 supports: vec![],
+                plastic: None,
             });
         }
         h

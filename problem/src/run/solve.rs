@@ -453,7 +453,12 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         newton_iterations: 0,
         failed_iterations: 0,
         seconds: 0.0,
-        point_arrays: crate::outputs::output::POINT_ARRAYS.iter().filter(|n| **n != "gap" || !punches.is_empty()).map(|s| s.to_string()).collect(),
+        point_arrays: crate::outputs::output::POINT_ARRAYS
+            .iter()
+            .filter(|n| **n != "gap" || !punches.is_empty())
+            .map(|s| s.to_string())
+            .chain(model.element.is_plastic().then(|| "thickness_strain".to_string()))
+            .collect(),
         cell_arrays: crate::outputs::output::cell_array_names(&model.element),
         coarse_predictor: None,
         refinement: opts.refinement.clone(),
@@ -546,7 +551,8 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         let penetration = m.contacts.iter().map(|c| c.max_penetration()).fold(0.0, f64::max);
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
         // (the reactions are the whole model's on every rank: its forces are summed over them)
-        let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u, supports.reactions(m, t)).clone();
+        let plastic = crate::outputs::plastic::plastic_extremes(&m.element, u, m.dofs.num_nodes());
+        let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u, supports.reactions(m, t), plastic).clone();
         // an interrupt from here on says this step converged, whether or not it is written
         prepare_notes(abort_note.as_ref(), &summary_path, &summary, rep.step, t);
         progress.step(rep, path_len, active, penetration, &history.terse_forces());

@@ -40,6 +40,38 @@ pub struct MaterialSpec {
     #[serde(rename = "G", default)]
     pub shear: Option<OneOrThree>,
     pub nu: OneOrThree,
+    /// `plasticity = { ... }` of an isotropic material (model/plasticity_spec.rs).
+    #[serde(default)]
+    pub plasticity: Option<PlasticitySpec>,
+}
+
+/// `plasticity = { hardening = "swift", K = 530.0, e0 = 0.005, n = 0.25, r = [1.8, 1.4, 2.2] }`,
+/// `{ yield = 150.0, hardening = "linear", H = 1000.0 }` or `{ table = [[0.0, 150.0], ...] }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlasticitySpec {
+    /// "linear" (default without `table`), "swift" or "table".
+    #[serde(default)]
+    pub hardening: Option<String>,
+    /// The initial yield stress of linear hardening.
+    #[serde(rename = "yield", default)]
+    pub yield_stress: Option<f64>,
+    /// The hardening modulus of linear hardening (default 0: perfectly plastic).
+    #[serde(rename = "H", default)]
+    pub modulus: Option<f64>,
+    /// Swift's sigma_y = K (e0 + ep)^n.
+    #[serde(rename = "K", default)]
+    pub k: Option<f64>,
+    #[serde(default)]
+    pub e0: Option<f64>,
+    #[serde(default)]
+    pub n: Option<f64>,
+    /// Rows [plastic strain, yield stress].
+    #[serde(default)]
+    pub table: Option<Vec<[f64; 2]>>,
+    /// Hill's r-values [r0, r45, r90] relative to x1 (the rolling direction); absent: von Mises.
+    #[serde(default)]
+    pub r: Option<[f64; 3]>,
 }
 
 /// One entry of `[plate] layers`.

@@ -33,6 +33,10 @@ pub struct PlateSpec {
     pub young: Option<Positive>,
     #[serde(default)]
     pub nu: Option<Poisson>,
+    /// ... or the name of a `[[material]]` (isotropic, possibly with `plasticity`) for the whole
+    /// plate (model/plasticity_spec.rs).
+    #[serde(default)]
+    pub material: Option<String>,
     /// The layers from the bottom face up (model/laminate_spec.rs); excludes `E`, `nu` and the thickness keys.
     #[serde(default)]
     pub layers: Option<Spanned<Vec<Spanned<LayerSpec>>>>,
@@ -98,10 +102,14 @@ impl Problem {
     pub(super) fn check_plate(&self) -> Result<()> {
         let s = &self.spec;
         let plate = s.plate.get_ref();
-        if plate.layers.is_none() {
+        if plate.material.is_some() {
+            if let Some(k) = [("E", plate.young.is_some()), ("nu", plate.nu.is_some()), ("layers", plate.layers.is_some())].iter().find(|(_, g)| *g).map(|(k, _)| k) {
+                return Err(self.error_at(s.plate.span(), &format!("plate.{k}"), format!("`material` and `{k}` exclude each other: the [[material]] named by `material` gives the plate's material")));
+            }
+        } else if plate.layers.is_none() {
             for (k, given) in [("E", plate.young.is_some()), ("nu", plate.nu.is_some())] {
                 if !given {
-                    return Err(self.error_at(s.plate.span(), &format!("plate.{k}"), format!("missing field `{k}`: give E and nu of a homogeneous plate, or `layers` with [[material]] tables")));
+                    return Err(self.error_at(s.plate.span(), &format!("plate.{k}"), format!("missing field `{k}`: give E and nu of a homogeneous plate, `material` = the name of a [[material]], or `layers` with [[material]] tables")));
                 }
             }
         }
