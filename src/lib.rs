@@ -14,6 +14,7 @@ pub mod surface;
 
 pub use error::{quote, show_path, short_path, Result, StampError};
 pub mod dofs;
+pub mod factor_path;
 pub mod element;
 pub mod linalg;
 pub mod memory;

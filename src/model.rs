@@ -15,6 +15,7 @@ use crate::dofs::DofMap;
 use crate::element::Element;
 use crate::follower::DeformationDependentLoad;
 use crate::error::{Result, StampError};
+use crate::factor_path::FactorPath;
 use crate::nonlinear::{Evaluation, NonlinearProblem};
 use crate::share::Share;
 use crate::linalg::sparse::SparsePattern;
@@ -37,8 +38,16 @@ type SavedContact = (Vec<f64>, Vec<PointState>, Vec<bool>, Option<crate::contact
 pub struct Model<E: Element> {
     pub element: E,
     pub dofs: DofMap,
-    /// Nodal forces (dof, value at load factor 1).
+    /// Nodal forces (dof, value at load factor 1), scaled by the load factor.
     pub loads: Vec<(usize, f64)>,
+    /// Nodal forces along a path: (dof, value, index into `load_paths`), scaled by the path's
+    /// factor instead of the load factor ([`Model::dead_loads`] gives both kinds at a load factor).
+    pub path_loads: Vec<(usize, f64, usize)>,
+    /// The paths of `path_loads` and of the displacement-dependent loads added with one.
+    pub load_paths: Vec<FactorPath>,
+    /// The path of each displacement-dependent load (index into `load_paths`), None: the load
+    /// factor; parallel to `follower_loads` (a load pushed there directly follows the load factor).
+    follower_paths: Vec<Option<usize>>,
     pub contacts: Vec<ContactPair>,
     /// Displacement-dependent loads (follower pressures, couples), at load factor 1, scaled by
     /// the load factor like `loads`.
@@ -130,6 +139,9 @@ impl<E: Element> Model<E> {
             element,
             dofs,
             loads: Vec::new(),
+            path_loads: Vec::new(),
+            load_paths: Vec::new(),
+            follower_paths: Vec::new(),
             contacts: Vec::new(),
             follower_loads: Vec::new(),
             follower_force: Vec::new(),
@@ -165,6 +177,38 @@ impl<E: Element> Model<E> {
         Ok(())
     }
 
+    /// A path loads may follow ([`Model::add_load_along`], [`Model::add_follower_load_along`]);
+    /// its index.
+    pub fn add_load_path(&mut self, path: FactorPath) -> usize {
+        if let Some(k) = self.load_paths.iter().position(|p| *p == path) {
+            return k;
+        }
+        self.load_paths.push(path);
+        self.load_paths.len() - 1
+    }
+
+    /// Add a nodal force `value` times the factor of `path` (from [`Model::add_load_path`]) at
+    /// each load factor.
+    pub fn add_load_along(&mut self, dof: usize, value: f64, path: usize) -> Result<()> {
+        if dof >= self.dofs.num_dofs() || !value.is_finite() || path >= self.load_paths.len() {
+            return Err(StampError::Problem(format!("invalid load {value} on dof {dof} along path {path}")));
+        }
+        self.path_loads.push((dof, value, path));
+        Ok(())
+    }
+
+    /// The factor of a load on `path` (None: the load factor itself) at load factor `t`.
+    pub fn load_factor_of(&self, path: Option<usize>, t: f64) -> f64 {
+        path.map_or(t, |k| self.load_paths[k].at(t))
+    }
+
+    /// Every nodal dead load at load factor `t`: (dof, force), those of `loads` times t and those
+    /// of `path_loads` times their path's factor.
+    pub fn dead_loads(&self, t: f64) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let on_paths = self.path_loads.iter().map(move |&(d, v, k)| (d, self.load_paths[k].at(t) * v));
+        self.loads.iter().map(move |&(d, v)| (d, t * v)).chain(on_paths)
+    }
+
     /// Internal + contact forces over all nodal dofs at the last evaluation; at prescribed dofs
     /// these are the support reactions (plus any load applied there): the force the support exerts
     /// on the body.
@@ -174,8 +218,23 @@ impl<E: Element> Model<E> {
 
     /// Add a displacement-dependent load (at load factor 1).
     pub fn add_follower_load(&mut self, load: Box<dyn DeformationDependentLoad>) {
+        self.follower_paths.resize(self.follower_loads.len(), None);
         self.follower_loads.push(load);
+        self.follower_paths.push(None);
         self.share_loads();
+    }
+
+    /// Add a displacement-dependent load scaled by the factor of `path` (from
+    /// [`Model::add_load_path`]) instead of the load factor.
+    pub fn add_follower_load_along(&mut self, load: Box<dyn DeformationDependentLoad>, path: usize) -> Result<()> {
+        if path >= self.load_paths.len() {
+            return Err(StampError::Problem(format!("no load path {path} (the model has {})", self.load_paths.len())));
+        }
+        self.add_follower_load(load);
+        if let Some(p) = self.follower_paths.last_mut() {
+            *p = Some(path);
+        }
+        Ok(())
     }
 
     /// The displacement-dependent loads' force over all nodal dofs at the last evaluation, at its
@@ -561,32 +620,47 @@ impl<E: Element> NonlinearProblem for Model<E> {
             }
         }
         if !self.follower_loads.is_empty() {
+            // each load's factor: t, or its path's (the loads on the load factor alone are summed
+            // first and scaled once, as before paths)
+            let scales: Vec<f64> = (0..self.follower_loads.len()).map(|k| self.load_factor_of(self.follower_paths.get(k).copied().flatten(), t)).collect();
+            let on_paths = self.follower_paths.iter().any(|p| p.is_some());
             self.follower_force.clear();
             self.follower_force.resize(nd, 0.0);
+            let mut own = if on_paths { vec![0.0; nd] } else { Vec::new() };
             let pattern = &self.pattern;
             let dofs = &self.dofs;
             let values = &mut self.values;
             let mine = owns_row(&self.share, dofs.dofs_per_node(), nd);
-            // R gets -t F, K gets -t dF/du (not symmetric: kept out of the preconditioner)
-            let mut add = |r: usize, c: usize, v: f64| {
-                if !mine(r, c) {
-                    return;
+            for (k, load) in self.follower_loads.iter().enumerate() {
+                let scale = scales[k];
+                // R gets -s F, K gets -s dF/du (not symmetric: kept out of the preconditioner)
+                let mut add = |r: usize, c: usize, v: f64| {
+                    if !mine(r, c) {
+                        return;
+                    }
+                    if let (Some(re), Some(ce)) = (dofs.equation(r), dofs.equation(c)) {
+                        if let Some(s) = pattern.find(re, ce) {
+                            values[s] -= scale * v;
+                        }
+                    }
+                };
+                let target = if on_paths { &mut own } else { &mut self.follower_force };
+                if with_tangent {
+                    load.add_force_and_stiffness(&u[..nd], target, Some(&mut add));
+                } else {
+                    load.add_force_and_stiffness(&u[..nd], target, None);
                 }
-                if let (Some(re), Some(ce)) = (dofs.equation(r), dofs.equation(c)) {
-                    if let Some(s) = pattern.find(re, ce) {
-                        values[s] -= t * v;
+                if on_paths {
+                    for (f, o) in self.follower_force.iter_mut().zip(own.iter_mut()) {
+                        *f += scale * *o;
+                        *o = 0.0;
                     }
                 }
-            };
-            for load in &self.follower_loads {
-                if with_tangent {
-                    load.add_force_and_stiffness(&u[..nd], &mut self.follower_force, Some(&mut add));
-                } else {
-                    load.add_force_and_stiffness(&u[..nd], &mut self.follower_force, None);
-                }
             }
-            for f in self.follower_force.iter_mut() {
-                *f *= t;
+            if !on_paths {
+                for f in self.follower_force.iter_mut() {
+                    *f *= t;
+                }
             }
             if let Some(share) = &self.share {
                 // this process's own nodes' forces, then every process's
@@ -631,10 +705,11 @@ impl<E: Element> NonlinearProblem for Model<E> {
         for k in 0..self.border.len() {
             self.residual[neq + k] = self.force[nd + k];
         }
-        for &(d, v) in &self.loads {
-            ext_sq += (t * v) * (t * v);
+        let on_paths = self.path_loads.iter().map(|&(d, v, k)| (d, self.load_paths[k].at(t) * v));
+        for (d, f) in self.loads.iter().map(|&(d, v)| (d, t * v)).chain(on_paths) {
+            ext_sq += f * f;
             if let Some(e) = self.dofs.equation(d) {
-                self.residual[e] -= t * v;
+                self.residual[e] -= f;
             }
         }
         let norm = self.residual.iter().map(|x| x * x).sum::<f64>().sqrt();

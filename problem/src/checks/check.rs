@@ -717,8 +717,9 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
         if !bs.fix.is_empty() {
             what.push(format!("fix {}", bs.fix.iter().map(|d| d.word.as_str()).collect::<Vec<_>>().join(", ")));
         }
+        let factor = if bs.path.is_some() { "its path's factor" } else { "load factor" };
         for (k, v) in &bs.prescribe {
-            what.push(format!("{} = {} x load factor", k.0, num(v.0)));
+            what.push(format!("{} = {} x {factor}", k.0, num(v.0)));
         }
         let _ = writeln!(o, "  boundary[{i}] on '{}': {}", quote(bs.group.get_ref()), what.join("; "));
     }
@@ -736,7 +737,12 @@ fn summary(p: &Problem, setup: &Setup, starts: &[PunchStart], rigid: &str) -> St
             }
             let kind = format!("{:?}", ls.kind).to_lowercase();
             let face = format!("{:?}", ls.face.unwrap_or_default()).to_lowercase();
-            let follows = if ls.follower { " (follower: in the reference state)" } else { "" };
+            let follows = match (ls.follower, ls.path.is_some()) {
+                (true, false) => " (follower: in the reference state)",
+                (true, true) => " (follower: in the reference state; times its path's factor, not the load factor)",
+                (false, true) => " (times its path's factor, not the load factor)",
+                (false, false) => "",
+            };
             if ls.kind == LoadKind::Moment {
                 let m = ls.moment.map(|m| m.0).unwrap_or([0.0; 3]);
                 let _ = writeln!(o, "  load[{i}]: moment on '{}', per unit length {}{follows}: total force 0", quote(ls.group.get_ref()), vec3(m));

@@ -97,7 +97,12 @@ fn face_of(f: PunchFace) -> Face {
 
 /// Put a nodal force on a face, or on the mid-plane (half on each face of the paper's plate, on
 /// each surface its weight in the mid-plane's displacement in the others).
-fn add_force(model: &mut Model<Plate>, layout: &Layout, node: usize, f: [f64; 3], face: LoadFace) -> Result<()> {
+/// `path`: the load's path (an index of [`Model::add_load_path`]), None: the load factor.
+fn add_force(model: &mut Model<Plate>, layout: &Layout, node: usize, f: [f64; 3], face: LoadFace, path: Option<usize>) -> Result<()> {
+    let mut add = |d: usize, v: f64| match path {
+        None => model.add_load(d, v),
+        Some(k) => model.add_load_along(d, v, k),
+    };
     for c in 0..3 {
         if f[c] == 0.0 {
             continue;
@@ -106,11 +111,11 @@ fn add_force(model: &mut Model<Plate>, layout: &Layout, node: usize, f: [f64; 3]
             LoadFace::Mid => {
                 // a force at the mid-plane: on each surface its weight in the mid-plane's displacement
                 for (d, w) in layout.mid_terms(node, c) {
-                    model.add_load(d, w * f[c])?;
+                    add(d, w * f[c])?;
                 }
             }
-            LoadFace::Top => model.add_load(layout.face_dof(Face::Top, node, c), f[c])?,
-            LoadFace::Bottom => model.add_load(layout.face_dof(Face::Bottom, node, c), f[c])?,
+            LoadFace::Top => add(layout.face_dof(Face::Top, node, c), f[c])?,
+            LoadFace::Bottom => add(layout.face_dof(Face::Bottom, node, c), f[c])?,
         }
     }
     Ok(())
@@ -355,11 +360,12 @@ fn build_boundary(p: &Problem, mesh: &MeshData, layout: &Layout) -> Result<(DofM
         dofs.fix(&nodes, &comps).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}]"), e))?;
         let dpn = layout.dofs_per_node;
         supports.hold(name, nodes.iter().flat_map(|&n| comps.iter().map(move |&c| n * dpn + c)));
+        let path = bs.path.as_ref().map(|q| dofs.add_path(q.get_ref().0.clone()));
         for (k, v) in &bs.prescribe {
             let comps = layout.fibre_components(&crate::schema::dof_components(&k.0).expect("checked word"));
             for &n in &nodes {
                 for &c in &comps {
-                    dofs.prescribe(n, c, v.0).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}].prescribe"), e))?;
+                    dofs.prescribe_along(n, c, v.0, path).map_err(|e| p.error_at(b.span(), &format!("boundary[{i}].prescribe"), e))?;
                 }
             }
             supports.hold(name, nodes.iter().flat_map(|&n| comps.iter().map(move |&c| n * dpn + c)));
@@ -378,6 +384,7 @@ fn build_loads(p: &Problem, mesh: &MeshData, section: &Section, layout: &Layout,
         let key = format!("load[{i}].group");
         let name = ls.group.get_ref();
         let face = ls.face.unwrap_or_default();
+        let path = ls.path.as_ref().map(|q| model.add_load_path(q.0.clone()));
         match ls.kind {
             LoadKind::Line => {
                 let segs = mesh.curves.get(name).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "curve", mesh))?;
@@ -385,7 +392,7 @@ fn build_loads(p: &Problem, mesh: &MeshData, section: &Section, layout: &Layout,
                 for s in segs {
                     let len = segment_length(mesh, s);
                     for &n in s {
-                        add_force(model, layout, n, f.map(|x| 0.5 * len * x), face)?;
+                        add_force(model, layout, n, f.map(|x| 0.5 * len * x), face, path)?;
                     }
                 }
             }
@@ -405,9 +412,11 @@ fn build_loads(p: &Problem, mesh: &MeshData, section: &Section, layout: &Layout,
                         crate::model::pressure::nodal_forces(p, spec.span(), &pkey, &mesh.mesh, cells, &*q)?;
                         let quads: Vec<[usize; 4]> = cells.iter().map(|&c| mesh.mesh.cells[c]).collect();
                         let what = format!("follower pressure on '{}'", stamp::quote(name));
-                        model.add_follower_load(Box::new(
-                            FollowerPressure::varying(what, &mesh.mesh.coords, &quads, f, z, &*q).with_dofs_per_node(layout.dofs_per_node),
-                        ));
+                        let load = Box::new(FollowerPressure::varying(what, &mesh.mesh.coords, &quads, f, z, &*q).with_dofs_per_node(layout.dofs_per_node));
+                        match path {
+                            None => model.add_follower_load(load),
+                            Some(k) => model.add_follower_load_along(load, k)?,
+                        }
                         continue;
                     }
                     let sign = if face == LoadFace::Top { -1.0 } else { 1.0 };
@@ -418,7 +427,7 @@ fn build_loads(p: &Problem, mesh: &MeshData, section: &Section, layout: &Layout,
                     };
                     for (n, &fz) in nodal.iter().enumerate() {
                         if fz != 0.0 {
-                            add_force(model, layout, n, [0.0, 0.0, sign * fz], face)?;
+                            add_force(model, layout, n, [0.0, 0.0, sign * fz], face, path)?;
                         }
                     }
                     continue;
@@ -427,7 +436,7 @@ fn build_loads(p: &Problem, mesh: &MeshData, section: &Section, layout: &Layout,
                 let w = mesh.nodal_areas_of(cells);
                 for (n, &a) in w.iter().enumerate() {
                     if a > 0.0 {
-                        add_force(model, layout, n, f.map(|x| a * x), face)?;
+                        add_force(model, layout, n, f.map(|x| a * x), face, path)?;
                     }
                 }
             }
@@ -445,19 +454,23 @@ fn build_loads(p: &Problem, mesh: &MeshData, section: &Section, layout: &Layout,
                 let couples: Vec<(usize, [f64; 3])> = share.iter().enumerate().filter(|(_, &w)| w > 0.0).map(|(n, &w)| (n, m.map(|x| w * x))).collect();
                 if ls.follower {
                     let what = format!("follower couple on '{}'", stamp::quote(name));
-                    model.add_follower_load(Box::new(FollowerCouple::new(what, couples, h).with_dofs_per_node(layout.dofs_per_node)));
+                    let load = Box::new(FollowerCouple::new(what, couples, h).with_dofs_per_node(layout.dofs_per_node));
+                    match path {
+                        None => model.add_follower_load(load),
+                        Some(k) => model.add_follower_load_along(load, k)?,
+                    }
                 } else {
                     for (n, mn) in couples {
                         let f = fixed_couple_force(mn, h);
-                        add_force(model, layout, n, f, LoadFace::Top)?;
-                        add_force(model, layout, n, f.map(|x| -x), LoadFace::Bottom)?;
+                        add_force(model, layout, n, f, LoadFace::Top, path)?;
+                        add_force(model, layout, n, f.map(|x| -x), LoadFace::Bottom, path)?;
                     }
                 }
             }
             LoadKind::Point => {
                 let nodes = mesh.points.get(name).cloned().or_else(|| mesh.nodes(name)).ok_or_else(|| group_error(p, ls.group.span(), &key, name, "", mesh))?;
                 for n in nodes {
-                    add_force(model, layout, n, ls.force.unwrap().0, face)?;
+                    add_force(model, layout, n, ls.force.unwrap().0, face, path)?;
                 }
             }
         }

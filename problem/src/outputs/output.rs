@@ -435,10 +435,10 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
             support[(d % dpn) % 3] += f;
         }
     }
-    for &(d, v) in &model.loads {
-        applied[(d % dpn) % 3] += t * v;
+    for (d, f) in model.dead_loads(t) {
+        applied[(d % dpn) % 3] += f;
         if model.dofs.equation(d).is_none() {
-            support[(d % dpn) % 3] -= t * v;
+            support[(d % dpn) % 3] -= f;
         }
     }
     // follower loads (pressures, couples): their force at the last evaluation, already times t

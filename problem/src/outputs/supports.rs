@@ -77,9 +77,9 @@ impl Supports {
                 for &d in &g.dofs {
                     r[(d % dpn) % 3] += force[d] - follower.get(d).copied().unwrap_or(0.0);
                 }
-                for &(d, v) in &model.loads {
+                for (d, f) in model.dead_loads(t) {
                     if g.dofs.binary_search(&d).is_ok() {
-                        r[(d % dpn) % 3] -= t * v;
+                        r[(d % dpn) % 3] -= f;
                     }
                 }
                 r

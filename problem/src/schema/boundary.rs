@@ -2,7 +2,7 @@
 //! by the constraint words.
 
 use super::Problem;
-use super::values::Finite;
+use super::values::{Finite, PathSpec};
 use serde::Deserialize;
 use serde::de::{Deserializer, Error as _};
 use stamp::Result;
@@ -74,6 +74,10 @@ pub struct BoundarySpec {
     /// Components prescribed to value * load factor.
     #[serde(default)]
     pub prescribe: BTreeMap<DofKey, Finite>,
+    /// Rows [t, factor]: the prescribed values are value times this factor at load factor t
+    /// (default: t).
+    #[serde(default)]
+    pub path: Option<Spanned<PathSpec>>,
 }
 
 impl Problem {
@@ -84,6 +88,11 @@ impl Problem {
             let bs = b.get_ref();
             if bs.fix.is_empty() && bs.prescribe.is_empty() {
                 return Err(self.error_at(b.span(), &format!("boundary[{i}]"), "needs `fix` or `prescribe`"));
+            }
+            if let Some(path) = &bs.path {
+                if bs.prescribe.is_empty() {
+                    return Err(self.error_at(path.span(), &format!("boundary[{i}].path"), "a path scales the values of `prescribe`, and this boundary prescribes none (`fix` holds at zero all along)"));
+                }
             }
         }
         Ok(())

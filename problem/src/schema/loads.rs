@@ -4,7 +4,7 @@
 
 use super::Problem;
 use super::limits;
-use super::values::{num, Vec3};
+use super::values::{num, PathSpec, Vec3};
 use serde::Deserialize;
 use serde::de::{Deserializer, Error as _};
 use stamp::Result;
@@ -57,6 +57,9 @@ pub struct LoadSpec {
     /// pressure, moment: the load follows the deformation (default false: a dead load).
     #[serde(default)]
     pub follower: bool,
+    /// Rows [t, factor]: the load is its value times this factor at load factor t (default: t).
+    #[serde(default)]
+    pub path: Option<PathSpec>,
 }
 
 /// A pressure: one number, or an expression in x1, x2.

@@ -113,3 +113,32 @@ impl<'de> Deserialize<'de> for Vec3 {
         }
     }
 }
+
+/// A factor along the load factor: rows `[[t, factor], ...]`, piecewise linear in t like a
+/// punch's `motion` rows (checked by [`stamp::factor_path::FactorPath::new`]): a `[[load]]`'s or
+/// a `[[boundary]]`'s `path`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathSpec(pub stamp::factor_path::FactorPath);
+impl<'de> Deserialize<'de> for PathSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        const FORM: &str = "expected rows [[t, factor], ...] (the factor piecewise linear in the load factor t)";
+        let rows = Vec::<Vec<f64>>::deserialize(d).map_err(|_| D::Error::custom(FORM))?;
+        if rows.len() > limits::MAX_PATH_ROWS {
+            return Err(D::Error::custom(format!("a path has at most {} rows, got {}", limits::MAX_PATH_ROWS, rows.len())));
+        }
+        let mut out = Vec::with_capacity(rows.len());
+        for (k, r) in rows.iter().enumerate() {
+            if r.len() != 2 {
+                return Err(D::Error::custom(format!("path row {k}: expected [t, factor], got {} numbers", r.len())));
+            }
+            if !r.iter().all(|x| x.is_finite() && x.abs() <= limits::MAX_MAGNITUDE) {
+                return Err(D::Error::custom(format!("path row {k}: expected finite numbers of magnitude at most 1e100, got {}", vec_text(r))));
+            }
+            if r[0] > limits::MAX_LOAD_FACTOR {
+                return Err(D::Error::custom(format!("path row {k}: the load factor t = {} is above the largest target allowed, 1e6", num(r[0]))));
+            }
+            out.push((r[0], r[1]));
+        }
+        stamp::factor_path::FactorPath::new(&out).map(PathSpec).map_err(|e| D::Error::custom(if e.starts_with("row") { format!("path {e}") } else { e }))
+    }
+}
