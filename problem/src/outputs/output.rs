@@ -154,6 +154,11 @@ pub struct StepEntry {
     /// The .vtu of this step (relative to the output folder), if written.
     pub vtu: Option<String>,
     pub csv: Vec<String>,
+    /// Per thickness probe with recovered stresses: [s13, s23, s33] integrated from the bottom
+    /// face to the top face minus the values the top face's traction gives them (the check of the
+    /// recovery, outputs/recovered_stresses.rs); absent when no probe recovers.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub thickness_top_mismatch: BTreeMap<String, [f64; 3]>,
 }
 
 /// Everything computed for one step.
@@ -457,6 +462,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         punches,
         vtu: None,
         csv: Vec::new(),
+        thickness_top_mismatch: BTreeMap::new(),
     };
     StepData { entry, point_fields, cell_fields: cell_fields(model, u), punch_rows }
 }

@@ -18,7 +18,10 @@
 
 use crate::model::mesh::MeshData;
 use crate::model::plate_model::Plate;
+use crate::model::build::PunchInfo;
 use crate::outputs::equilibrium_shear::ShearRecovery;
+use crate::outputs::face_tractions::FaceLoads;
+use crate::outputs::recovered_stresses::{FaceTractions, StressRecovery};
 use crate::outputs::probe::CellLocator;
 use crate::schema::{Problem, DEFAULT_POINTS_PER_LAYER};
 use stamp::element::Element;
@@ -36,6 +39,8 @@ struct Item {
     points: usize,
     /// With `transverse_shear = "equilibrium"`: the in-plane stresses' recovery around the point.
     recovery: Option<ShearRecovery>,
+    /// With recovered stresses: the fit around the point and the loads on its faces.
+    recovered: Option<(StressRecovery, FaceLoads)>,
 }
 
 /// The thickness probes of a run.
@@ -71,21 +76,41 @@ impl ThicknessProbes {
             } else {
                 None
             };
-            items.push(Item { name: spec.name.clone(), cells, mirror, points: spec.points_per_layer.unwrap_or(DEFAULT_POINTS_PER_LAYER), recovery });
+            let recovered = if spec.recovered() {
+                let holding: Vec<usize> = cells.iter().map(|c| c.0).collect();
+                let fit = StressRecovery::new(&mesh.mesh, &holding, spec.at, &symmetry_planes(p, mesh)).ok_or_else(|| {
+                    p.error_at(
+                        s.span(),
+                        &format!("output.thickness_probe[{i}].stresses"),
+                        format!("the recovered stresses fit a cubic through the cells around {:?}, but their centres do not determine it (too few cells, or a strip one cell wide): use stresses = \"law\" or a finer mesh", spec.at),
+                    )
+                })?;
+                Some((fit, FaceLoads::at(p, mesh, &cells, spec.at)))
+            } else {
+                None
+            };
+            items.push(Item { name: spec.name.clone(), cells, mirror, points: spec.points_per_layer.unwrap_or(DEFAULT_POINTS_PER_LAYER), recovery, recovered });
         }
         Ok(ThicknessProbes { items })
     }
 
-    /// Write the CSV of every probe for `step`; returns the files written.
-    pub fn write_step(&self, dir: &Path, step: usize, model: &Model<Plate>, u: &[f64]) -> Result<Vec<PathBuf>> {
+    /// Write the CSV of every probe for `step` (load factor `t`, the punches `punches` of the
+    /// model); returns the files written and, per probe with recovered stresses, the top face's
+    /// mismatch [s13, s23, s33] (see outputs/recovered_stresses.rs).
+    pub fn write_step(&self, dir: &Path, step: usize, t: f64, model: &Model<Plate>, punches: &[PunchInfo], cells: &[[usize; 4]], u: &[f64]) -> Result<(Vec<PathBuf>, Vec<(String, [f64; 3])>)> {
         let mut files = Vec::new();
+        let mut mismatches = Vec::new();
         for item in &self.items {
-            let text = csv(item, model, u).ok_or_else(|| StampError::Input { file: String::new(), message: "a thickness probe needs a plate of three to five surfaces or layers".into() })?;
+            let faces = item.recovered.as_ref().map(|(_, loads)| loads.tractions(t, model, punches, cells));
+            let (text, mismatch) = csv(item, model, u, faces.as_ref()).ok_or_else(|| StampError::Input { file: String::new(), message: "a thickness probe needs a plate of three to five surfaces or layers".into() })?;
             let path = dir.join(format!("thickness_{}_{step:04}.csv", item.name));
             write_string_atomically(&path, &text)?;
             files.push(path);
+            if let Some(m) = mismatch {
+                mismatches.push((item.name.clone(), m));
+            }
         }
-        Ok(files)
+        Ok((files, mismatches))
     }
 }
 
@@ -130,8 +155,9 @@ fn on_symmetry_plane(p: &Problem, mesh: &MeshData, at: [f64; 2], d: usize) -> bo
     })
 }
 
-/// The rows of one probe.
-fn csv(item: &Item, model: &Model<Plate>, u: &[f64]) -> Option<String> {
+/// The rows of one probe (with recovered stresses: the faces' tractions `faces`), and the
+/// recovery's top-face mismatch.
+fn csv(item: &Item, model: &Model<Plate>, u: &[f64], faces: Option<&FaceTractions>) -> Option<(String, Option<[f64; 3]>)> {
     let plate = &model.element;
     let (lam, per_layer, mid) = plate.stress_stack()?;
     let dpn = plate.dofs_per_node();
@@ -149,11 +175,20 @@ fn csv(item: &Item, model: &Model<Plate>, u: &[f64]) -> Option<String> {
         })
         .collect();
     let weight = 1.0 / places.len() as f64;
-    let mut out = String::from("x3,layer,u1,u2,u3,s11,s22,s33,s12,s13,s23\n");
+    let mut heights: Vec<(usize, f64)> = Vec::new();
     for k in 0..lam.plies.len() {
-        let slots = lam.ply_slots(per_layer, k);
         for j in 0..item.points {
-            let x3 = if j + 1 == item.points { b[k + 1] } else { b[k] + (b[k + 1] - b[k]) * j as f64 / (item.points - 1) as f64 };
+            heights.push((k, if j + 1 == item.points { b[k + 1] } else { b[k] + (b[k + 1] - b[k]) * j as f64 / (item.points - 1) as f64 }));
+        }
+    }
+    let column = match (&item.recovered, faces) {
+        (Some((fit, _)), Some(f)) => Some(fit.column(plate, &lam, u, &heights, f)?),
+        _ => None,
+    };
+    let mut out = String::from("x3,layer,u1,u2,u3,s11,s22,s33,s12,s13,s23\n");
+    for (row_index, &(k, x3)) in heights.iter().enumerate() {
+        let slots = lam.ply_slots(per_layer, k);
+        {
             let (l, _) = stamp_elements::multi_surface::lagrange(&zs, 2.0 * (x3 - 0.5 * (b[k] + b[k + 1])) / (b[k + 1] - b[k]));
             // [u1, u2, u3, s11, s22, s33, s12, s13, s23], the mean over the cells
             let mut row = [0.0; 9];
@@ -161,10 +196,16 @@ fn csv(item: &Item, model: &Model<Plate>, u: &[f64]) -> Option<String> {
                 for i in 0..3 {
                     row[i] += weight * (0..4).map(|a| shape[a] * slots.iter().zip(&l).map(|(&sl, &ls)| ls * local[dpn * a + 3 * sl + i]).sum::<f64>()).sum::<f64>();
                 }
-                let g = plate.layer_stresses(cell, k, x3, local, &mut ws)?;
-                for (r, c) in [(3, 0), (4, 1), (5, 2), (6, 5), (7, 4), (8, 3)] {
-                    row[r] += weight * (0..4).map(|q| at_gauss[q] * g[q][c]).sum::<f64>();
+                if column.is_none() {
+                    let g = plate.layer_stresses(cell, k, x3, local, &mut ws)?;
+                    for (r, c) in [(3, 0), (4, 1), (5, 2), (6, 5), (7, 4), (8, 3)] {
+                        row[r] += weight * (0..4).map(|q| at_gauss[q] * g[q][c]).sum::<f64>();
+                    }
                 }
+            }
+            if let Some(c) = &column {
+                // [s11, s22, s33, s12, s13, s23]
+                row[3..9].copy_from_slice(&c.rows[row_index]);
             }
             if let Some(r) = &item.recovery {
                 let [s13, s23] = r.shear(plate, &lam, u, k, x3)?;
@@ -189,5 +230,5 @@ fn csv(item: &Item, model: &Model<Plate>, u: &[f64]) -> Option<String> {
             out.push('\n');
         }
     }
-    Some(out)
+    Some((out, column.map(|c| c.mismatch)))
 }
