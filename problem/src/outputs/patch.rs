@@ -64,20 +64,17 @@ impl Patch {
                         next.push(x);
                     }
                 };
+                // the cells around each node, and across a plane the images of the cells that
+                // share a node on it (a node on the plane is its own image, so the images around
+                // it are neighbours too; a node on both planes has all three images around it)
                 for &n in &mesh.cells[c] {
-                    for &c2 in &node_cells[&n] {
-                        add((c2, img));
-                    }
-                }
-                // across a plane: the images of the cells that share a node on it (a node on
-                // the plane is its own image, so the images around it are neighbours too)
-                for d in 0..2 {
-                    let Some(p) = plane[d] else { continue };
-                    let mut flipped = img;
-                    flipped[d] = !flipped[d];
-                    for &n in mesh.cells[c].iter().filter(|&&n| (mesh.coords[n][d] - p).abs() <= tol) {
+                    let on: [bool; 2] = std::array::from_fn(|d| plane[d].is_some_and(|p| (mesh.coords[n][d] - p).abs() <= tol));
+                    for flip in [[false, false], [true, false], [false, true], [true, true]] {
+                        if (0..2).any(|d| flip[d] && !on[d]) {
+                            continue;
+                        }
                         for &c2 in &node_cells[&n] {
-                            add((c2, flipped));
+                            add((c2, [img[0] != flip[0], img[1] != flip[1]]));
                         }
                     }
                 }

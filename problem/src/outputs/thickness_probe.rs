@@ -46,6 +46,9 @@ struct Item {
 /// The thickness probes of a run.
 pub struct ThicknessProbes {
     items: Vec<Item>,
+    /// The probes that recover by default but whose mesh does not determine the fit (they read
+    /// the law's stresses), one sentence each.
+    pub warnings: Vec<String>,
 }
 
 impl ThicknessProbes {
@@ -53,10 +56,11 @@ impl ThicknessProbes {
     pub fn new(p: &Problem, mesh: &MeshData) -> Result<ThicknessProbes> {
         let probes = &p.spec.output.thickness_probe;
         if probes.is_empty() {
-            return Ok(ThicknessProbes { items: Vec::new() });
+            return Ok(ThicknessProbes { items: Vec::new(), warnings: Vec::new() });
         }
         let locator = CellLocator::new(&mesh.mesh);
         let mut items = Vec::new();
+        let mut warnings = Vec::new();
         for (i, s) in probes.iter().enumerate() {
             let spec = s.get_ref();
             let cells = locator.locate_all(spec.at);
@@ -78,20 +82,24 @@ impl ThicknessProbes {
             };
             let recovered = if spec.recovered() {
                 let holding: Vec<usize> = cells.iter().map(|c| c.0).collect();
-                let fit = StressRecovery::new(&mesh.mesh, &holding, spec.at, &symmetry_planes(p, mesh)).ok_or_else(|| {
-                    p.error_at(
-                        s.span(),
-                        &format!("output.thickness_probe[{i}].stresses"),
-                        format!("the recovered stresses fit a cubic through the cells around {:?}, but their centres do not determine it (too few cells, or a strip one cell wide): use stresses = \"law\" or a finer mesh", spec.at),
-                    )
-                })?;
-                Some((fit, FaceLoads::at(p, mesh, &cells, spec.at)))
+                match StressRecovery::new(&mesh.mesh, &holding, spec.at, &symmetry_planes(p, mesh)) {
+                    Some(fit) => Some((fit, FaceLoads::at(p, mesh, &cells, spec.at))),
+                    None => {
+                        let why = format!("the recovered stresses fit a cubic through the cells around {:?}, but their centres do not determine it (too few cells, or a strip one cell wide)", spec.at);
+                        if spec.stresses.is_some() {
+                            return Err(p.error_at(s.span(), &format!("output.thickness_probe[{i}].stresses"), format!("{why}: use stresses = \"law\" or a finer mesh")));
+                        }
+                        // the default: the law, said
+                        warnings.push(format!("output.thickness_probe[{i}] ('{}'): {why}; it writes the 3D law's stresses (stresses = \"law\" says so and silences this)", spec.name));
+                        None
+                    }
+                }
             } else {
                 None
             };
             items.push(Item { name: spec.name.clone(), cells, mirror, points: spec.points_per_layer.unwrap_or(DEFAULT_POINTS_PER_LAYER), recovery, recovered });
         }
-        Ok(ThicknessProbes { items })
+        Ok(ThicknessProbes { items, warnings })
     }
 
     /// Write the CSV of every probe for `step` (load factor `t`, the punches `punches` of the

@@ -88,7 +88,7 @@ impl ThicknessProbeSpec {
 }
 
 /// Whether a thickness probe recovers its stresses when the file says nothing.
-pub const DEFAULT_RECOVERED: bool = false;
+pub const DEFAULT_RECOVERED: bool = true;
 
 /// Names, points and counts, with file, line and key; a laminate is needed.
 pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>]) -> Result<()> {
