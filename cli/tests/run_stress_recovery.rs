@@ -294,3 +294,41 @@ fn a_default_probe_on_a_strip_reads_the_law_and_is_warned_about() {
     assert_eq!(rows(&out), rows(&law));
     assert!(summary(&out)["steps"][0].get("thickness_top_mismatch").is_none());
 }
+
+/// The bottom face's traction starts the integration: the cross-ply plate (symmetric about its
+/// mid-plane) pressed from below is the mirror image (x3 -> -x3) of the plate pressed from above,
+/// so the probe's rows read the same s11, s22, s33, s12 at -x3 and s13, s23 of opposite sign,
+/// to round-off; s33 on the bottom face is minus the pressure there.
+#[test]
+fn a_plate_pressed_from_below_reads_the_mirrored_stresses() {
+    let (sr, n) = (10.0, 8);
+    let l = 0.5 * sr / n as f64;
+    let probes = [("centre", 0.5 * sr, 0.5 * sr), ("inner", 3.0 * l, 5.0 * l)];
+    let top = problem(&CROSS_PLY, sr, n, 4, &probes, "");
+    // a pressure pushes on its face towards the plate: upwards on the bottom face
+    let bottom = top.replace("face = \"top\"", "face = \"bottom\"");
+    assert_ne!(top, bottom);
+    let dir = temp_dir("stress-recovery-below");
+    let mut tables = Vec::new();
+    for (name, text) in [("top", &top), ("bottom", &bottom)] {
+        let out = dir.join(name);
+        stamp_cli::run::run(&write(&dir, &format!("{name}.toml"), text), Some(&out), true).unwrap();
+        tables.push(probes.map(|(p, _, _)| {
+            let mut files: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).filter(|f| f.starts_with(&format!("thickness_{p}_"))).collect();
+            files.sort();
+            read_csv(&out.join(files.last().unwrap()))
+        }));
+    }
+    for (i, (p, x, y)) in probes.iter().enumerate() {
+        let (a, b) = (&tables[0][i], &tables[1][i]);
+        let q = (std::f64::consts::PI * x / sr).sin() * (std::f64::consts::PI * y / sr).sin();
+        assert!((b[0][7] + q).abs() < 1e-12, "{p}: s33 on the loaded bottom face {} against {}", b[0][7], -q);
+        let scale = a.iter().flat_map(|r| r[5..11].iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+        for (ra, rb) in a.iter().zip(b.iter().rev()) {
+            assert!((ra[0] + rb[0]).abs() < 1e-12);
+            for (col, sign) in [(5, 1.0), (6, 1.0), (7, 1.0), (8, 1.0), (9, -1.0), (10, -1.0)] {
+                assert!((ra[col] - sign * rb[col]).abs() <= 1e-8 * scale, "{p}, column {col}: {} from above, {} from below", ra[col], rb[col]);
+            }
+        }
+    }
+}
