@@ -5,9 +5,13 @@
 //! `points_per_layer` rows per layer, evenly spaced, its faces included, so an interface has one
 //! row for each of its two layers).
 //!
-//! The stresses are the second Piola-Kirchhoff stresses in the plate's axes by each layer's 3D law
+//! The displacement is the element's interpolation at the point. The stresses (second
+//! Piola-Kirchhoff, in the plate's axes) are by default recovered (`stresses = "recovered"`,
+//! outputs/recovered_stresses.rs: patch fits and 3D equilibrium through the thickness, the faces'
+//! tractions from outputs/face_tractions.rs); with `stresses = "law"`, or a probe that names
+//! `transverse_shear`, or where the mesh does not determine the fit, they are each layer's 3D law
 //! from the element's strains at the four Gauss points, extrapolated bilinearly to the point (the
-//! in-plane position inside its element); the displacement is the element's interpolation there.
+//! in-plane position inside its element), as follows.
 //! A point on an edge or a node is held by several cells: their extrapolated values are averaged
 //! with equal weights. A point on a symmetry plane (a boundary group fixed with `symmetry_x1` or
 //! `symmetry_x2` whose nodes lie on one line x1 or x2 = const through the point) counts the
@@ -196,47 +200,45 @@ fn csv(item: &Item, model: &Model<Plate>, u: &[f64], faces: Option<&FaceTraction
     let mut out = String::from("x3,layer,u1,u2,u3,s11,s22,s33,s12,s13,s23\n");
     for (row_index, &(k, x3)) in heights.iter().enumerate() {
         let slots = lam.ply_slots(per_layer, k);
-        {
-            let (l, _) = stamp_elements::multi_surface::lagrange(&zs, 2.0 * (x3 - 0.5 * (b[k] + b[k + 1])) / (b[k + 1] - b[k]));
-            // [u1, u2, u3, s11, s22, s33, s12, s13, s23], the mean over the cells
-            let mut row = [0.0; 9];
-            for ((local, shape, at_gauss), &(cell, _)) in places.iter().zip(&item.cells) {
-                for i in 0..3 {
-                    row[i] += weight * (0..4).map(|a| shape[a] * slots.iter().zip(&l).map(|(&sl, &ls)| ls * local[dpn * a + 3 * sl + i]).sum::<f64>()).sum::<f64>();
-                }
-                if column.is_none() {
-                    let g = plate.layer_stresses(cell, k, x3, local, &mut ws)?;
-                    for (r, c) in [(3, 0), (4, 1), (5, 2), (6, 5), (7, 4), (8, 3)] {
-                        row[r] += weight * (0..4).map(|q| at_gauss[q] * g[q][c]).sum::<f64>();
-                    }
+        let (l, _) = stamp_elements::multi_surface::lagrange(&zs, 2.0 * (x3 - 0.5 * (b[k] + b[k + 1])) / (b[k + 1] - b[k]));
+        // [u1, u2, u3, s11, s22, s33, s12, s13, s23], the mean over the cells
+        let mut row = [0.0; 9];
+        for ((local, shape, at_gauss), &(cell, _)) in places.iter().zip(&item.cells) {
+            for i in 0..3 {
+                row[i] += weight * (0..4).map(|a| shape[a] * slots.iter().zip(&l).map(|(&sl, &ls)| ls * local[dpn * a + 3 * sl + i]).sum::<f64>()).sum::<f64>();
+            }
+            if column.is_none() {
+                let g = plate.layer_stresses(cell, k, x3, local, &mut ws)?;
+                for (r, c) in [(3, 0), (4, 1), (5, 2), (6, 5), (7, 4), (8, 3)] {
+                    row[r] += weight * (0..4).map(|q| at_gauss[q] * g[q][c]).sum::<f64>();
                 }
             }
-            if let Some(c) = &column {
-                // [s11, s22, s33, s12, s13, s23]
-                row[3..9].copy_from_slice(&c.rows[row_index]);
-            }
-            if let Some(r) = &item.recovery {
-                let [s13, s23] = r.shear(plate, &lam, u, k, x3)?;
-                row[7] = s13;
-                row[8] = s23;
-            }
-            // a mirror image's odd components cancel the cell's
-            if item.mirror[0] {
-                for r in [0, 6, 7] {
-                    row[r] = 0.0;
-                }
-            }
-            if item.mirror[1] {
-                for r in [1, 6, 8] {
-                    row[r] = 0.0;
-                }
-            }
-            out.push_str(&format!("{:e},{k}", x3 + mid));
-            for v in row {
-                out.push_str(&format!(",{v:e}"));
-            }
-            out.push('\n');
         }
+        if let Some(c) = &column {
+            // [s11, s22, s33, s12, s13, s23]
+            row[3..9].copy_from_slice(&c.rows[row_index]);
+        }
+        if let Some(r) = &item.recovery {
+            let [s13, s23] = r.shear(plate, &lam, u, k, x3)?;
+            row[7] = s13;
+            row[8] = s23;
+        }
+        // a mirror image's odd components cancel the cell's
+        if item.mirror[0] {
+            for r in [0, 6, 7] {
+                row[r] = 0.0;
+            }
+        }
+        if item.mirror[1] {
+            for r in [1, 6, 8] {
+                row[r] = 0.0;
+            }
+        }
+        out.push_str(&format!("{:e},{k}", x3 + mid));
+        for v in row {
+            out.push_str(&format!(",{v:e}"));
+        }
+        out.push('\n');
     }
     Some((out, column.map(|c| c.mismatch)))
 }
