@@ -350,6 +350,12 @@ fn bad_thickness_probes_are_refused_by_name() {
         ("name", pagano_problem(2, 3) + &probe("[1.0, 1.0]", "").replace("\"c\"", "\"a b\""), vec!["output.thickness_probe[0].name"]),
         ("twice", pagano_problem(2, 3) + &probe("[1.0, 1.0]", "") + &probe("[2.0, 1.0]", ""), vec!["output.thickness_probe[1].name", "two thickness probes"]),
         ("shear", pagano_problem(2, 3) + &probe("[1.0, 1.0]", "transverse_shear = \"both\"\n"), vec!["output.thickness_probe[0].transverse_shear", "\"law\" or \"equilibrium\"", "both"]),
+        ("stresses", pagano_problem(2, 3) + &probe("[1.0, 1.0]", "stresses = \"both\"\n"), vec!["output.thickness_probe[0].stresses", "\"recovered\" or \"law\"", "both"]),
+        (
+            "recovered_shear",
+            pagano_problem(2, 3) + &probe("[1.0, 1.0]", "stresses = \"recovered\"\ntransverse_shear = \"equilibrium\"\n"),
+            vec!["output.thickness_probe[0].transverse_shear", "applies to stresses = \"law\""],
+        ),
     ] {
         let path = write(&dir, &format!("{name}.toml"), &text);
         let err = Problem::read(&path).err().unwrap_or_else(|| panic!("{name}: accepted")).to_string();
@@ -360,6 +366,9 @@ fn bad_thickness_probes_are_refused_by_name() {
     let path = write(&dir, "strip.toml", &(pagano_problem(2, 3).replace("n = [2, 2]", "n = [4, 1]") + &probe("[1.0, 1.0]", "transverse_shear = \"equilibrium\"\n")));
     let err = stamp_cli::run::run(&path, Some(&dir.join("strip")), true).err().expect("refused").to_string();
     assert!(err.contains("output.thickness_probe[0].transverse_shear") && err.contains("one cell wide"), "{err}");
+    let path = write(&dir, "strip_recovered.toml", &(pagano_problem(2, 3).replace("n = [2, 2]", "n = [4, 1]") + &probe("[1.0, 1.0]", "stresses = \"recovered\"\n")));
+    let err = stamp_cli::run::run(&path, Some(&dir.join("strip_recovered")), true).err().expect("refused").to_string();
+    assert!(err.contains("output.thickness_probe[0].stresses") && err.contains("one cell wide"), "{err}");
     let path = write(&dir, "outside.toml", &(pagano_problem(2, 3) + &probe("[7.0, 1.0]", "")));
     let err = stamp_cli::run::run(&path, Some(&dir.join("outside")), true).err().expect("refused").to_string();
     assert!(err.contains("output.thickness_probe[0].at") && err.contains("not on the plate"), "{err}");

@@ -72,7 +72,7 @@ pub struct CheckReport {
 pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
     check_groups(p, &setup.mesh)?;
     check_punch_forces(p, setup)?;
-    check_outputs(p, setup)?;
+    let probe_warnings = check_outputs(p, setup)?;
     let size = model_size(setup);
     let mut starts = Vec::new();
     for i in 0..setup.punches.len() {
@@ -83,6 +83,7 @@ pub fn check(p: &Problem, setup: &Setup) -> Result<CheckReport> {
     let rigid = check_rigid_modes(p, setup, &starts, size)?;
     let mut warnings = punch_warnings(p, setup, &starts);
     warnings.extend(crate::checks::cell_shape::aspect_warning(p, &setup.mesh));
+    warnings.extend(probe_warnings);
     let summary = summary(p, setup, &starts, &rigid);
     Ok(CheckReport { summary, warnings, punches: starts })
 }
@@ -117,17 +118,18 @@ fn check_punch_forces(p: &Problem, setup: &Setup) -> Result<()> {
 /// What the run checks of the outputs before its first step, checked here too so that `stamp
 /// check` passes only what `stamp run` accepts: probe lines and thickness probes on the plate (a
 /// point off the mesh, "equilibrium" where the cells around the point cannot be fitted), and
-/// thickness probes only on plates that have stresses through the thickness.
-fn check_outputs(p: &Problem, setup: &Setup) -> Result<()> {
+/// thickness probes only on plates that have stresses through the thickness. Returns the thickness
+/// probes' warnings (a default recovery the mesh cannot fit).
+fn check_outputs(p: &Problem, setup: &Setup) -> Result<Vec<String>> {
     let names: Vec<String> = setup.punches.iter().map(|i| i.name.clone()).collect();
     crate::outputs::probe::Probes::new(p, &setup.mesh, &p.spec.output.probe, &names)?;
-    crate::outputs::thickness_probe::ThicknessProbes::new(p, &setup.mesh)?;
+    let warnings = crate::outputs::thickness_probe::ThicknessProbes::new(p, &setup.mesh)?.warnings;
     if let Some(first) = p.spec.output.thickness_probe.first() {
         if setup.model.element.stress_stack().is_none() {
             return Err(p.error_at(first.span(), "output.thickness_probe[0]", "a thickness probe reads the stresses through the thickness: it needs `[plate] surfaces` = 3 to 5, or `layers`"));
         }
     }
-    Ok(())
+    Ok(warnings)
 }
 
 /// How deep punch `i` may reach, in its undeformed position, below a node whose surfaces the

@@ -16,6 +16,7 @@
 
 use crate::model::plate_model::Plate;
 use stamp::element::Element;
+use crate::outputs::patch::Patch;
 use stamp::mesh::QuadMesh;
 use stamp_elements::Laminate;
 
@@ -46,100 +47,16 @@ impl ShearRecovery {
     /// None when the cells' centres do not determine a quadratic (too few, or in a line: a strip
     /// one cell wide).
     pub fn new(mesh: &QuadMesh, holding: &[usize], at: [f64; 2], planes: &[Vec<f64>; 2]) -> Option<ShearRecovery> {
-        let tol = 1e-9 * mesh.element_size();
-        // for each axis, the plane nearest the point (a patch two rings wide reaches one)
-        let plane: [Option<f64>; 2] = std::array::from_fn(|d| planes[d].iter().copied().min_by(|a, b| (a - at[d]).abs().total_cmp(&(b - at[d]).abs())));
-        // (cell, image: mirrored across x1's plane, across x2's)
-        let mut patch: Vec<(usize, [bool; 2])> = Vec::new();
-        for &c in holding {
-            for img in [[false, false], [true, false], [false, true], [true, true]] {
-                // an image holds the point when the point is on the planes it mirrors across
-                if (0..2).all(|d| !img[d] || plane[d].is_some_and(|p| (at[d] - p).abs() <= tol)) && !patch.contains(&(c, img)) {
-                    patch.push((c, img));
-                }
-            }
-        }
-        let mut node_cells: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
-        for (c, cell) in mesh.cells.iter().enumerate() {
-            for &n in cell {
-                node_cells.entry(n).or_default().push(c);
-            }
-        }
-        for _ring in 0..2 {
-            let mut next = patch.clone();
-            for &(c, img) in &patch {
-                let mut add = |x: (usize, [bool; 2])| {
-                    if !next.contains(&x) {
-                        next.push(x);
-                    }
-                };
-                for &n in &mesh.cells[c] {
-                    for &c2 in &node_cells[&n] {
-                        add((c2, img));
-                    }
-                }
-                // across a plane: the images of the cells that share a node on it (a node on
-                // the plane is its own image, so the images around it are neighbours too)
-                for d in 0..2 {
-                    let Some(p) = plane[d] else { continue };
-                    let mut flipped = img;
-                    flipped[d] = !flipped[d];
-                    for &n in mesh.cells[c].iter().filter(|&&n| (mesh.coords[n][d] - p).abs() <= tol) {
-                        for &c2 in &node_cells[&n] {
-                            add((c2, flipped));
-                        }
-                    }
-                }
-            }
-            patch = next;
-        }
-        let mut cells: Vec<usize> = Vec::new();
-        for &(c, _) in &patch {
-            if !cells.contains(&c) {
-                cells.push(c);
-            }
-        }
+        let patch = Patch::around(mesh, holding, at, planes);
         let size = mesh.element_size();
-        // (cell index, centre of the cell or its image relative to `at` / size, sign of s12 by
-        // image: odd under each mirror)
-        let mut samples = Vec::new();
-        for &(c, img) in &patch {
-            let i = cells.iter().position(|&x| x == c).expect("listed");
-            let x = mesh.cell_coords(c);
-            let pos: [f64; 2] = std::array::from_fn(|d| {
-                let centre = 0.25 * (0..4).map(|a| x[a][d]).sum::<f64>();
-                let centre = match (img[d], plane[d]) {
-                    (true, Some(p)) => 2.0 * p - centre,
-                    _ => centre,
-                };
-                (centre - at[d]) / size
-            });
-            samples.push((i, pos, if img[0] != img[1] { -1.0 } else { 1.0 }));
-        }
-        // least squares on [1, x, y, x^2, xy, y^2]: the rows of (A^T A)^-1 A^T for x and y
-        let basis = |p: [f64; 2]| [1.0, p[0], p[1], p[0] * p[0], p[0] * p[1], p[1] * p[1]];
-        let mut m = nalgebra::Matrix6::<f64>::zeros();
-        for s in &samples {
-            let b = basis(s.1);
-            for r in 0..6 {
-                for c in 0..6 {
-                    m[(r, c)] += b[r] * b[c];
-                }
-            }
-        }
-        let sv = m.singular_values();
-        if !(sv.min() > 1e-10 * sv.max()) {
-            return None;
-        }
-        let inv = m.try_inverse()?;
-        let points = samples
+        let weights = patch.quadratic_weights()?;
+        let points = patch
+            .samples
             .iter()
-            .map(|&(i, p, sign)| {
-                let w = inv * nalgebra::Vector6::from(basis(p));
-                (i, [w[1] / size, w[2] / size], [sign * w[1] / size, sign * w[2] / size])
-            })
+            .zip(&weights)
+            .map(|(s, w)| (s.cell, [w[1] / size, w[2] / size], [s.s12_sign * w[1] / size, s.s12_sign * w[2] / size]))
             .collect();
-        Some(ShearRecovery { cells, points })
+        Some(ShearRecovery { cells: patch.cells, points })
     }
 
     /// [s11,1 + s12,2, s12,1 + s22,2] at height x3 of layer k.

@@ -160,6 +160,11 @@ pub struct StepEntry {
     pub max_plastic_strain: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub min_thickness: Option<f64>,
+    /// Per thickness probe with recovered stresses: [s13, s23, s33] integrated from the bottom
+    /// face to the top face minus the values the top face's traction gives them (the check of the
+    /// recovery, outputs/recovered_stresses.rs); absent when no probe recovers.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub thickness_top_mismatch: BTreeMap<String, [f64; 3]>,
 }
 
 /// Everything computed for one step.
@@ -473,6 +478,7 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         csv: Vec::new(),
         max_plastic_strain: plastic.map(|p| p.0),
         min_thickness: plastic.map(|p| p.1),
+        thickness_top_mismatch: BTreeMap::new(),
     };
     StepData { entry, point_fields, cell_fields: cell_fields(model, u), punch_rows }
 }

@@ -593,10 +593,12 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
                     data.entry.csv.push(name);
                 }
             }
-            for path in thickness_probes.write_step(out_dir, rep.step, m, u)? {
+            let (files, mismatches) = thickness_probes.write_step(out_dir, rep.step, t, m, &punches, &mesh.mesh.cells, u)?;
+            for path in files {
                 data.entry.csv.push(path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default());
                 written.push(path);
             }
+            data.entry.thickness_top_mismatch.extend(mismatches);
             for path in probes.write_step(out_dir, rep.step, &row, &punch_names, &m.contacts, &history.layout, u)? {
                 data.entry.csv.push(path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default());
                 written.push(path);

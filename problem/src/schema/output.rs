@@ -67,7 +67,28 @@ pub struct ThicknessProbeSpec {
     /// bottom face (outputs/equilibrium_shear.rs).
     #[serde(default)]
     pub transverse_shear: Option<String>,
+    /// `"recovered"`: all six stresses recovered (in-plane by patch fits, s13, s23, s33 integrated
+    /// from 3D equilibrium, outputs/recovered_stresses.rs); `"law"`: each layer's 3D law at the
+    /// Gauss points, extrapolated (with `transverse_shear`). The default: see
+    /// [`ThicknessProbeSpec::recovered`].
+    #[serde(default)]
+    pub stresses: Option<String>,
 }
+
+impl ThicknessProbeSpec {
+    /// Whether the probe recovers its stresses: `stresses = "recovered"`, or neither `stresses`
+    /// nor `transverse_shear` given (a probe with `transverse_shear` reads the law's stresses, as
+    /// it always did).
+    pub fn recovered(&self) -> bool {
+        match &self.stresses {
+            Some(s) => s == "recovered",
+            None => self.transverse_shear.is_none() && DEFAULT_RECOVERED,
+        }
+    }
+}
+
+/// Whether a thickness probe recovers its stresses when the file says nothing.
+pub const DEFAULT_RECOVERED: bool = true;
 
 /// Names, points and counts, with file, line and key; a laminate is needed.
 pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>]) -> Result<()> {
@@ -90,6 +111,18 @@ pub fn check_thickness_probes(p: &Problem, probes: &[Spanned<ThicknessProbeSpec>
         if let Some(t) = &spec.transverse_shear {
             if t != "law" && t != "equilibrium" {
                 return Err(p.error_at(s.span(), &format!("{key}.transverse_shear"), format!("expected \"law\" or \"equilibrium\", got {}", stamp::quote(t))));
+            }
+        }
+        if let Some(t) = &spec.stresses {
+            if t != "law" && t != "recovered" {
+                return Err(p.error_at(s.span(), &format!("{key}.stresses"), format!("expected \"recovered\" or \"law\", got {}", stamp::quote(t))));
+            }
+            if t == "recovered" && spec.transverse_shear.is_some() {
+                return Err(p.error_at(
+                    s.span(),
+                    &format!("{key}.transverse_shear"),
+                    "applies to stresses = \"law\": the recovered stresses integrate s13 and s23 from equilibrium themselves (remove `transverse_shear`, or write stresses = \"law\")",
+                ));
             }
         }
         if let Some(n) = spec.points_per_layer {
