@@ -551,7 +551,8 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         let penetration = m.contacts.iter().map(|c| c.max_penetration()).fold(0.0, f64::max);
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
         // (the reactions are the whole model's on every rank: its forces are summed over them)
-        let plastic = crate::outputs::plastic::plastic_extremes(&m.element, u, m.dofs.num_nodes());
+        // (the writing process holds every element; the others only their own)
+        let plastic = if crate::run::parallel::writes_outputs() { crate::outputs::plastic::plastic_extremes(&m.element, u, m.dofs.num_nodes()) } else { None };
         let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u, supports.reactions(m, t), plastic).clone();
         // an interrupt from here on says this step converged, whether or not it is written
         prepare_notes(abort_note.as_ref(), &summary_path, &summary, rep.step, t);
