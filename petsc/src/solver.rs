@@ -277,6 +277,13 @@ impl PetscSolver {
         ksp.set_tolerances(RTOL, 0.0, MAX_ITERATIONS)?;
         ksp.set_pc_type(if p.is_some() { "cholesky" } else { "lu" })?;
         ksp.set_factor_solver("mumps")?;
+        // MUMPS sizes its workspace from the analysis plus ICNTL(14) per cent (20 to 35 by
+        // default); the pivoting of some steps on 4 ranks needed more and failed with
+        // FACTOR_OUTMEMORY (the laminate example, now and then): 100 per cent, unless the user's
+        // options say otherwise
+        if !self.options.contains("-mat_mumps_icntl_14") {
+            self.petsc.insert_options("-mat_mumps_icntl_14 100")?;
+        }
         ksp.set_from_options()?;
         // GMRES (the default, unless the options chose another method) is preconditioned from the
         // right, so that it judges the true residual; CG and others keep PETSc's side
