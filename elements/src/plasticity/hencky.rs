@@ -5,7 +5,7 @@
 //!   H = 1/2 ln C,  C = I + 2 E;   S = P^T T,   dS/dE = P^T (dT/dH) P + T : d2H/dE2,
 //!
 //! with P = dH/dE. In the eigenbasis C = Q diag(c) Q^T the derivatives are divided differences of
-//! ln (Daleckii-Krein): dH[dE]^ = F1 o dE^ with F1_ij = ln[c_i, c_j], and
+//! ln (Daleckii-Krein): `dH[dE]^ = F1 o dE^` with `F1_ij = ln[c_i, c_j]`, and
 //! T : d2H[A, B] = 2 sum_ijk T^_ij ln[c_i, c_k, c_j] (A^_ik B^_kj + B^_ik A^_kj), ^ the components in
 //! the eigenbasis. H equals E to first order, so at small strains the law is the small-strain one.
 

@@ -61,7 +61,7 @@ fn m6(a: &[[f64; 6]; 6]) -> M6 {
 #[derive(Debug, Clone, Copy)]
 pub struct YieldBasis {
     pub m: Quadratic,
-    /// v[i] the i-th generalised eigenvector.
+    /// `v[i]`: the i-th generalised eigenvector.
     pub v: [[f64; 6]; 6],
     pub omega: [f64; 6],
 }

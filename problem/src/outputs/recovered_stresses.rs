@@ -47,7 +47,7 @@ const GAUSS5: [(f64, f64); 5] = [
 ];
 
 /// The tractions acting on the plate's faces at the point, force per unit area in the plate's
-/// axes: s_i3 = -bottom[i] on the bottom face, s_i3 = top[i] on the top face (a pressure p on
+/// axes: s_i3 = -bottom\[i\] on the bottom face, s_i3 = top\[i\] on the top face (a pressure p on
 /// either face: s33 = -p).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FaceTractions {
