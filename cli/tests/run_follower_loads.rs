@@ -4,7 +4,6 @@
 
 mod common;
 use common::*;
-use stamp_cli::run::{build::build, Problem};
 
 #[test]
 fn cantilever_roll_example_follows_the_exact_circles_and_closes_at_full_load() {
@@ -88,14 +87,7 @@ fn follower_pressure_applied_load_is_balanced_by_the_clamp_and_bends_further_tha
 }
 
 fn error_of(name: &str, text: &str) -> String {
-    let dir = temp_dir(&format!("bad-follower-{name}"));
-    let path = write(&dir, &format!("{name}.toml"), text);
-    let err = match Problem::read(&path).and_then(|p| build(&p).map(|_| ())) {
-        Ok(()) => panic!("{name}: the problem was accepted:\n{text}"),
-        Err(e) => e.to_string(),
-    };
-    assert!(err.contains(&format!("{name}.toml")), "{name}: the error does not name the file: {err}");
-    err
+    build_error("bad-follower", name, text)
 }
 
 #[test]

@@ -6,17 +6,9 @@
 
 mod common;
 use common::*;
-use stamp_cli::run::{build::build, Problem};
 
 fn error_of(name: &str, text: &str) -> String {
-    let dir = temp_dir(&format!("bad-plastic-{name}"));
-    let path = write(&dir, &format!("{name}.toml"), text);
-    let err = match Problem::read(&path).and_then(|p| build(&p).map(|_| ())) {
-        Ok(()) => panic!("{name}: the problem was accepted:\n{text}"),
-        Err(e) => e.to_string(),
-    };
-    assert!(err.contains(&format!("{name}.toml")), "{name}: the error does not name the file: {err}");
-    err
+    build_error("bad-plastic", name, text)
 }
 
 /// A quarter plate 12 x 12 (6 x 6 cells, h = 1), clamped, pressed 1.2 by a sphere of radius 10 at

@@ -3,18 +3,12 @@
 
 mod common;
 use common::*;
+use stamp_cli::run::{build::build, Problem};
 use serde_json::Value;
 use std::process::Command;
-use stamp_cli::run::{build::build, Problem};
 
 fn error_of(name: &str, text: &str) -> String {
-    let dir = temp_dir(&format!("bad-{name}"));
-    let path = write(&dir, &format!("{name}.toml"), text);
-    let err = match Problem::read(&path).and_then(|p| build(&p).map(|_| ())) {
-        Ok(()) => panic!("{name}: the problem was accepted:\n{text}"),
-        Err(e) => e.to_string(),
-    };
-    assert!(err.contains(&format!("{name}.toml")), "{name}: the error does not name the file: {err}");
+    let err = build_error("bad", name, text);
     eprintln!("{name}: {err}\n");
     err
 }

@@ -112,3 +112,17 @@ pub fn run_text(name: &str, text: &str) -> PathBuf {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     out
 }
+
+/// The error of building the problem `text`, written as `<name>.toml` into a fresh folder named
+/// `<folder>-<name>`: the problem must be refused, and the error must name the file.
+pub fn build_error(folder: &str, name: &str, text: &str) -> String {
+    use stamp_cli::run::{build::build, Problem};
+    let dir = temp_dir(&format!("{folder}-{name}"));
+    let path = write(&dir, &format!("{name}.toml"), text);
+    let err = match Problem::read(&path).and_then(|p| build(&p).map(|_| ())) {
+        Ok(()) => panic!("{name}: the problem was accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains(&format!("{name}.toml")), "{name}: the error does not name the file: {err}");
+    err
+}
