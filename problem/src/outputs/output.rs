@@ -453,7 +453,6 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
             support[(d % dpn) % 3] -= f;
         }
     }
-    let plastic = crate::outputs::plastic::plastic_extremes(&model.element, u, cx.mesh.mesh.num_nodes());
     let entry = StepEntry {
         step: report.step,
         load_factor: t,
@@ -476,8 +475,9 @@ pub fn step_data(cx: &Context, model: &Model<Plate>, u: &[f64], t: f64, path: f6
         punches,
         vtu: None,
         csv: Vec::new(),
-        max_plastic_strain: plastic.map(|p| p.0),
-        min_thickness: plastic.map(|p| p.1),
+        // the run's history row has them (computed once per step, crate::outputs::plastic)
+        max_plastic_strain: None,
+        min_thickness: None,
         thickness_top_mismatch: BTreeMap::new(),
     };
     StepData { entry, point_fields, cell_fields: cell_fields(model, u), punch_rows }

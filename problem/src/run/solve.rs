@@ -552,7 +552,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
         let active = m.contacts.iter().map(|c| c.state.iter().filter(|s| s.active).count()).sum();
         // (the reactions are the whole model's on every rank: its forces are summed over them)
         // (the writing process holds every element; the others only their own)
-        let plastic = if crate::run::parallel::writes_outputs() { crate::outputs::plastic::plastic_extremes(&m.element, u, m.dofs.num_nodes()) } else { None };
+        let plastic = if writer { crate::outputs::plastic::plastic_extremes(&m.element, u, m.dofs.num_nodes()) } else { None };
         let row = history.record(rep.step, t, path_len, rep.iterations, &m.contacts, u, supports.reactions(m, t), plastic).clone();
         // an interrupt from here on says this step converged, whether or not it is written
         prepare_notes(abort_note.as_ref(), &summary_path, &summary, rep.step, t);
@@ -568,6 +568,7 @@ pub fn solve_and_write(p: &Problem, setup: Setup, out_dir: &Path, opts: &SolveOp
             return;
         }
         let mut data = step_data(&cx, m, u, t, path_len, rep);
+        (data.entry.max_plastic_strain, data.entry.min_thickness) = (row.plastic.map(|p| p.0), row.plastic.map(|p| p.1));
         // the step's files first; only when all of them are written is the step listed (.pvd and
         // summary.json), and a step that failed half-way leaves no file behind
         let mut written: Vec<PathBuf> = Vec::new();
