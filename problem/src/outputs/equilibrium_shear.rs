@@ -20,7 +20,8 @@ use crate::outputs::patch::Patch;
 use stamp::mesh::QuadMesh;
 use stamp_elements::Laminate;
 
-const GAUSS5: [(f64, f64); 5] = [
+/// The 5-point Gauss rule on [-1, 1] (abscissa, weight), for integrals through a layer.
+pub(crate) const GAUSS5: [(f64, f64); 5] = [
     (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
     (-0.538_469_310_105_683, 0.478_628_670_499_366_5),
     (0.0, 0.568_888_888_888_888_9),

@@ -38,13 +38,7 @@ use stamp::element::Element;
 use stamp::mesh::QuadMesh;
 use stamp_elements::Laminate;
 
-const GAUSS5: [(f64, f64); 5] = [
-    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
-    (-0.538_469_310_105_683, 0.478_628_670_499_366_5),
-    (0.0, 0.568_888_888_888_888_9),
-    (0.538_469_310_105_683, 0.478_628_670_499_366_5),
-    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
-];
+use crate::outputs::equilibrium_shear::GAUSS5;
 
 /// The tractions acting on the plate's faces at the point, force per unit area in the plate's
 /// axes: s_i3 = -bottom\[i\] on the bottom face, s_i3 = top\[i\] on the top face (a pressure p on
